@@ -1,0 +1,88 @@
+// Deterministic parallel scatter without atomics: particles are counting-sorted into blocks of
+// B^D cells and blocks are coloured 2^D ways. Two blocks of one colour are ≥ B cells apart, so
+// their stencils (a particle may drift up to `margin` cells out of its block before a re-sort)
+// never share a node. Colours run one after another; within a colour each block is summed by one
+// thread in particle order, so every node sum has the same order for any thread count.
+#pragma once
+#include "Grid.hpp"
+#include "Particles.hpp"
+#include <vector>
+
+namespace mpm {
+
+template <int D>
+struct BlockSchedule {
+	using IVec                  = typename Dim<D>::IVec;
+	static constexpr int B      = 8; // cells per block edge
+	static constexpr int margin = 1; // cells a particle may leave its block before a re-sort
+	static_assert(B + 3 + 2 * margin < 2 * B, "same-colour blocks must not share stencil nodes");
+
+	IVec                  nBlocks;
+	std::vector<uint32_t> start;               // particles of block b: [start[b], start[b+1])
+	std::vector<uint32_t> colour[1 << D];      // non-empty blocks per colour
+	std::vector<uint32_t> perm, count, key;    // sort work arrays (kept: no allocation while stepping)
+	std::vector<Real>     tmp;
+
+	size_t blockCount() const
+	{
+		size_t n = 1;
+		for (int a = 0; a < D; ++a) n *= nBlocks[a];
+		return n;
+	}
+	IVec blockCoords(size_t b) const
+	{
+		IVec c;
+		for (int a = 0; a < D; ++a) {
+			c[a] = int(b % nBlocks[a]);
+			b /= nBlocks[a];
+		}
+		return c;
+	}
+	size_t blockOf(const Grid<D>& g, const Particles<D>& P, size_t p) const
+	{
+		size_t b = 0, s = 1;
+		for (int a = 0; a < D; ++a) {
+			int c = int(std::floor((P.x[a][p] - g.origin[a]) / g.spacing)) / B;
+			c     = std::min(std::max(c, 0), nBlocks[a] - 1);
+			b += size_t(c) * s;
+			s *= nBlocks[a];
+		}
+		return b;
+	}
+	// Is a particle at cell coordinates `cell` still close enough to block b?
+	bool within(size_t b, const int* cell) const
+	{
+		IVec bc = blockCoords(b);
+		for (int a = 0; a < D; ++a)
+			if (cell[a] < bc[a] * B - margin || cell[a] >= (bc[a] + 1) * B + margin) return false;
+		return true;
+	}
+
+	// Stable counting sort of the particles by block; permutes every particle field.
+	void sort(const Grid<D>& g, Particles<D>& P)
+	{
+		for (int a = 0; a < D; ++a) nBlocks[a] = (g.cells[a] + B - 1) / B;
+		const size_t nb = blockCount();
+		count.assign(nb + 1, 0);
+		key.resize(P.n);
+		for (size_t p = 0; p < P.n; ++p) {
+			key[p] = uint32_t(blockOf(g, P, p));
+			++count[key[p] + 1];
+		}
+		for (size_t b = 0; b < nb; ++b) count[b + 1] += count[b];
+		start.assign(count.begin(), count.end());
+		perm.resize(P.n);
+		for (size_t p = 0; p < P.n; ++p) perm[count[key[p]]++] = uint32_t(p);
+		P.permute(perm, tmp);
+		for (auto& c : colour) c.clear();
+		for (size_t b = 0; b < nb; ++b) {
+			if (start[b] == start[b + 1]) continue;
+			IVec bc = blockCoords(b);
+			int  k  = 0;
+			for (int a = 0; a < D; ++a) k |= (bc[a] & 1) << a;
+			colour[k].push_back(uint32_t(b));
+		}
+	}
+};
+
+} // namespace mpm

@@ -1,0 +1,554 @@
+// Explicit WLS-MPM with MUSL (paper Sec. 2.5, Fig. 2). One step, in the order of the flow chart:
+//
+//   p2g();         lumped mass, momentum, internal/external force      Eqs. 20–22
+//   gridUpdate();  nodal momentum balance with lumped mass, boundaries  Eq. 18
+//   (contact();    PTS contact with rigid bodies joins here, Eqs. 23–26)
+//   g2p();         particle velocity, position rate; MUSL remap         Eqs. 6–7, 16–17
+//   gridMusl();    nodal MUSL velocities                                Eq. 16
+//   updateStress(); velocity gradient and constitutive update           Eqs. 7, 27–40
+#pragma once
+#include "BlockSchedule.hpp"
+#include "DruckerPragerGradyKipp.hpp"
+#include "WlsShape.hpp"
+#include <omp.h>
+#include <sstream>
+
+namespace mpm {
+
+enum class MaterialKind : int { None = -1, Elastic = 0, DruckerPragerGradyKipp = 1 };
+
+// Wall time per phase [s], summed over steps (for the benchmark).
+struct PhaseTimes {
+	double sort = 0, p2g = 0, grid = 0, g2p = 0, stress = 0;
+};
+
+template <int D>
+class Solver {
+public:
+	using Vec  = typename Dim<D>::Vec;
+	using IVec = typename Dim<D>::IVec;
+	static constexpr int N  = Dim<D>::nStencil;
+	static constexpr int NS = Dim<D>::nSym;
+
+	// ---- settings (each validated where it is set) ----
+	Vec  gravity          = Vec::Zero(); // g [m/s²]
+	Real damping          = 0;   // Cundall local damping α on nodal forces: f ← f − α|f|sign(v) [-], 0 ≤ α < 1
+	Real courant          = 0.5; // C in Δt = C·l/(v_c + max‖v‖) [-], 0 < C ≤ 1
+	bool autoDt           = true; // recompute Δt every step from the stability condition
+	Real fixedDt          = 0;   // Δt used when autoDt is false [s]
+	Real tractionRampTime = 0;   // particle surface forces ramp linearly from 0 over this time [s]; 0 = at once
+	int  sortPeriod       = 50;  // re-sort particles by block at least every this many steps
+	bool trackEnergy      = false; // accumulate external work (costs one extra pass)
+
+	// ---- state ----
+	Grid<D>      grid;
+	Particles<D> P;
+	Real         time = 0;   // simulated time [s]
+	long         steps = 0;
+	Real         lastDt = 0; // Δt of the last step [s]
+	Real         externalWork = 0; // work of gravity and surface forces on the particles [J] (trackEnergy)
+	PhaseTimes   phase;
+
+	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), offs(grid) { }
+
+	// ---------------------------------------------------------------- set-up
+	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n)
+	{
+		if (n == 0) throw InputError("particles: the particle set to add is empty");
+		const Vec lo = grid.origin, hi = grid.upper();
+		for (size_t p = 0; p < n; ++p) {
+			for (int a = 0; a < D; ++a) {
+				Real xa = x[p * D + a];
+				if (!std::isfinite(xa)) throw InputError("position of particle " + std::to_string(P.n + p) + " is not finite (NaN or inf)");
+				if (xa < lo[a] || xa >= hi[a])
+					throw InputError(
+					        "position of particle " + std::to_string(P.n + p) + " is outside the grid along axis " + std::to_string(a) + ": "
+					        + std::to_string(xa) + " m not in [" + std::to_string(lo[a]) + ", " + std::to_string(hi[a]) + ") m");
+			}
+			if (!(std::isfinite(vol[p]) && vol[p] > 0))
+				throw InputError("volume of particle " + std::to_string(P.n + p) + " must be finite and > 0 m³ (got " + std::to_string(vol[p]) + ")");
+			if (!(std::isfinite(mass[p]) && mass[p] > 0))
+				throw InputError("mass of particle " + std::to_string(P.n + p) + " must be finite and > 0 kg (got " + std::to_string(mass[p]) + ")");
+		}
+		const size_t old = P.n;
+		P.n += n;
+		P.forEachRealField([&](std::vector<Real>& f) { f.resize(P.n, 0.0); });
+		P.id.resize(P.n);
+		for (size_t p = 0; p < n; ++p) {
+			for (int a = 0; a < D; ++a) P.x[a][old + p] = x[p * D + a];
+			P.vol[old + p] = P.vol0[old + p] = vol[p];
+			P.mass[old + p]                  = mass[p];
+			P.id[old + p]                    = int64_t(old + p);
+		}
+		if (kind == MaterialKind::DruckerPragerGradyKipp) initDamageThresholds(old);
+		needSort = true;
+	}
+
+	void setMaterial(const ElasticMat& m)
+	{
+		m.validate();
+		elastic = m;
+		kind    = MaterialKind::Elastic;
+	}
+	void setMaterial(const DpGkMat& m)
+	{
+		m.validate();
+		dpgk    = m;
+		elastic = m;
+		kind    = MaterialKind::DruckerPragerGradyKipp;
+		P.ensureDamageState();
+		initDamageThresholds(0);
+	}
+	MaterialKind materialKind() const { return kind; }
+	const ElasticMat& elasticParameters() const { return elastic; }
+	const DpGkMat& dpgkParameters() const { return dpgk; }
+
+	void addBoundaryPlane(int axis, int side, Real position, BoundaryKind k) { grid.addPlane({ axis, side, position, k }); }
+
+	// Surface force on particle slot p (traction × tributary area) [N].
+	void setParticleForce(size_t p, const Vec& f)
+	{
+		if (p >= P.n) throw InputError("particle index " + std::to_string(p) + " is outside [0, " + std::to_string(P.n) + ")");
+		for (int a = 0; a < D; ++a) requireFinite(f[a], "particle surface force");
+		P.ensureTraction();
+		for (int a = 0; a < D; ++a) P.trac[a][p] = f[a];
+	}
+
+	void setSetting(const char* name, Real v)
+	{
+		std::string n(name);
+		if (n == "damping") requireRange(v, 0, 1, false, true, "damping", "[-]"), damping = v;
+		else if (n == "courant") requireRange(v, 0, 1, true, false, "courant", "[-]"), courant = v;
+		else if (n == "fixedDt") requireRange(v, 0, INFINITY, true, true, "fixedDt", "[s]"), fixedDt = v;
+		else if (n == "tractionRampTime") requireRange(v, 0, INFINITY, false, true, "tractionRampTime", "[s]"), tractionRampTime = v;
+		else if (n == "sortPeriod") requireRange(v, 1, 1e9, false, false, "sortPeriod", "[steps]"), sortPeriod = int(v);
+		else throw InputError("unknown setting " + n);
+	}
+
+	// ---------------------------------------------------------------- time step
+	// Characteristic P-wave speed v_c = √((K + 4G/3)/ρ_min) [m/s].
+	Real waveSpeed() const { return std::sqrt(elastic.pWaveModulus() / rhoMin); }
+	// Paper's stability condition Δt = C·l/(v_c + max‖v‖) with the current particle velocities.
+	Real stableDt()
+	{
+		prepare();
+		return courant * grid.spacing / (waveSpeed() + vmax);
+	}
+	// One step with the automatic Δt (autoDt) or fixedDt.
+	void step()
+	{
+		prepare();
+		if (autoDt) advance(stableDt());
+		else advance(fixedDt);
+	}
+	// One step of length dt; dt above the stable step is refused.
+	void advance(Real dt)
+	{
+		prepare();
+		requireRange(dt, 0, INFINITY, true, true, "dt", "[s]");
+		const Real lim = stableDt();
+		if (dt > lim * (1 + 1e-12))
+			throw InputError(
+			        "dt = " + fmt(dt) + " s exceeds the stable time step " + fmt(lim) + " s (Δt ≤ C·l/(v_c + max‖v‖), C = " + fmt(courant)
+			        + "); lower dt or switch autoDt on");
+		double t0 = omp_get_wtime();
+		if (needSort || (steps % sortPeriod) == 0) {
+			sched.sort(grid, P);
+			needSort = false;
+		}
+		double t1 = omp_get_wtime();
+		phase.sort += t1 - t0;
+		withMaterial([&](const auto& mat) {
+			double a = omp_get_wtime();
+			p2g(mat);
+			double b = omp_get_wtime();
+			gridUpdate(dt);
+			// contact(dt): PTS contact with rigid bodies (Eqs. 23–26) is applied to the nodes here.
+			double c = omp_get_wtime();
+			g2p();
+			gridMusl();
+			double d = omp_get_wtime();
+			updateStress(mat, dt);
+			double e = omp_get_wtime();
+			phase.p2g += b - a;
+			phase.grid += c - b;
+			phase.g2p += d - c;
+			phase.stress += e - d;
+		});
+		if (trackEnergy) accumulateExternalWork(dt);
+		time += dt;
+		lastDt = dt;
+		++steps;
+	}
+
+	// ---------------------------------------------------------------- diagnostics
+	Real kineticEnergy() const
+	{
+		Real e = 0;
+		for (size_t p = 0; p < P.n; ++p)
+			for (int a = 0; a < D; ++a) e += 0.5 * P.mass[p] * P.v[a][p] * P.v[a][p];
+		return e;
+	}
+	// Elastic energy stored by the (effective) stress, Σ V (s:s/(4G) + σm²/(2K)) [J].
+	Real elasticEnergy() const
+	{
+		const Real K = elastic.bulk(), G = elastic.shear();
+		Real       e = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			Sym<D> s  = effectiveStress(p);
+			Real   sm = s.toDeviator();
+			e += P.vol[p] * (s.contract() / (4 * G) + sm * sm / (2 * K));
+		}
+		return e;
+	}
+	// The stress the particle carries: the damaged stress for DP–GK (Eq. 40), else the state.
+	Sym<D> effectiveStress(size_t p) const
+	{
+		if (kind == MaterialKind::DruckerPragerGradyKipp) return DruckerPragerGradyKipp<D>::damaged(P.stress(p), P.damage[p]);
+		return P.stress(p);
+	}
+	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
+	Real maxSpeed() const { return vmax; }
+	const BlockSchedule<D>& schedule() const { return sched; }
+	void requestSort() { needSort = true; }
+
+private:
+	MaterialKind      kind = MaterialKind::None;
+	ElasticMat        elastic;
+	DpGkMat           dpgk;
+	BlockSchedule<D>  sched;
+	StencilOffsets<D> offs;
+	bool              needSort = true;
+	Real              vmax = 0, rhoMin = INFINITY, massFloor = 0;
+
+	struct ErrorRecord {
+		size_t      particle = SIZE_MAX;
+		std::string what;
+		void record(size_t p, const std::string& w)
+		{
+#pragma omp critical(mpm_error)
+			if (p < particle) particle = p, what = w;
+		}
+	};
+
+	static std::string fmt(Real v)
+	{
+		std::ostringstream o;
+		o.precision(6);
+		o << v;
+		return o.str();
+	}
+
+	template <class F>
+	void withMaterial(F&& f)
+	{
+		if (kind == MaterialKind::Elastic) f(LinearElastic<D>(elastic));
+		else f(DruckerPragerGradyKipp<D>(dpgk));
+	}
+
+	void initDamageThresholds(size_t from)
+	{
+		if (!dpgk.damage) return;
+		P.ensureDamageState();
+		for (size_t p = from; p < P.n; ++p) P.eps0[p] = dpgk.activationStrain(P.vol0[p]); // Eq. 37
+	}
+
+	// Validation that must precede any work; cheap when nothing changed.
+	void prepare()
+	{
+		if (P.n == 0) throw InputError("particles: no particles in the solver; add particles before stepping");
+		if (kind == MaterialKind::None) throw InputError("material: no material assigned; set a material before stepping");
+		if (!std::isfinite(rhoMin) || needSort) {
+			Real mmin = INFINITY;
+			rhoMin    = INFINITY;
+			for (size_t p = 0; p < P.n; ++p) {
+				rhoMin = std::min(rhoMin, P.mass[p] / P.vol[p]);
+				mmin   = std::min(mmin, P.mass[p]);
+				for (int a = 0; a < D; ++a)
+					if (!std::isfinite(P.v[a][p])) throw InputError("velocity of particle id " + std::to_string(P.id[p]) + " is not finite");
+				for (int k = 0; k < NS; ++k)
+					if (!std::isfinite(P.sig[k][p])) throw InputError("stress of particle id " + std::to_string(P.id[p]) + " is not finite");
+				Real sp = 0;
+				for (int a = 0; a < D; ++a) sp += P.v[a][p] * P.v[a][p];
+				vmax = std::max(vmax, std::sqrt(sp));
+			}
+			massFloor = 1e-9 * mmin; // nodes lighter than this carry no velocity
+		}
+	}
+
+	// Particles of block b.
+	template <class F>
+	void forBlock(uint32_t b, F&& f) const
+	{
+		for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) f(size_t(p));
+	}
+	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums).
+	template <class F>
+	void scatterPass(F&& f)
+	{
+#pragma omp parallel
+		for (int c = 0; c < Dim<D>::nColours; ++c) {
+			const auto& blocks = sched.colour[c];
+#pragma omp for schedule(dynamic, 1)
+			for (size_t k = 0; k < blocks.size(); ++k) forBlock(blocks[k], f);
+		}
+	}
+	void throwIf(const ErrorRecord& e, const char* phaseName)
+	{
+		if (e.particle == SIZE_MAX) return;
+		throw SimulationError(
+		        "MPM stopped at step " + std::to_string(steps) + " (t = " + fmt(time) + " s) in " + phaseName + ": particle id " + std::to_string(P.id[e.particle])
+		        + " " + e.what);
+	}
+	bool stencilOf(size_t p, Stencil<D>& st) const
+	{
+		Real x[D];
+		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+		return computeStencil(grid, offs, x, st);
+	}
+	Real dxOf(const Stencil<D>& st, int n, int a) const { return st.d[a][Stencil<D>::along(n, a)]; }
+
+	// ---------------------------------------------------------------- P2G: Eqs. 20–22
+	template <class Mat>
+	void p2g(const Mat& mat)
+	{
+		auto& nodes = grid.nodes;
+#pragma omp parallel for schedule(static)
+		for (size_t i = 0; i < nodes.size(); ++i) nodes[i] = Node<D> {};
+		const Real  s = loadScale(time);
+		ErrorRecord err;
+		scatterPass([&](size_t p) {
+			Stencil<D> st;
+			if (!stencilOf(p, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			const Real   m = P.mass[p], V = P.vol[p];
+			const Sym<D> sg = mat.forceStress(P, p);
+			Real         mv[D], mC[D][D], fe[D];
+			for (int a = 0; a < D; ++a) {
+				mv[a] = m * P.v[a][p];
+				for (int b = 0; b < D; ++b) mC[a][b] = m * P.C[a * D + b][p];
+				fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
+			}
+			for (int n = 0; n < N; ++n) {
+				Node<D>&    nd  = nodes[st.base + offs.off[n]];
+				const Real  psi = st.psi[n];
+				const Real* g   = st.grad[n];
+				nd.m += psi * m;     // Eq. 20
+				nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
+				Real sg_g[D];
+				stressTimesVector(sg, g, sg_g);
+				for (int a = 0; a < D; ++a) {
+					Real mom = mv[a];
+					for (int b = 0; b < D; ++b) mom += mC[a][b] * dxOf(st, n, b);
+					nd.a[a] += psi * mom;                       // momentum of the affine velocity field (Eq. 16)
+					nd.b[a] += -V * sg_g[a] + psi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+				}
+			}
+		});
+		throwIf(err, "P2G");
+	}
+	static void stressTimesVector(const Sym<D>& s, const Real* g, Real* out)
+	{
+		if constexpr (D == 2) {
+			out[0] = s.c[0] * g[0] + s.c[3] * g[1];
+			out[1] = s.c[3] * g[0] + s.c[1] * g[1];
+		} else {
+			out[0] = s.c[0] * g[0] + s.c[3] * g[1] + s.c[4] * g[2];
+			out[1] = s.c[3] * g[0] + s.c[1] * g[1] + s.c[5] * g[2];
+			out[2] = s.c[4] * g[0] + s.c[5] * g[1] + s.c[2] * g[2];
+		}
+	}
+
+	// ---------------------------------------------------------------- grid: Eq. 18 with lumped mass
+	void gridUpdate(Real dt)
+	{
+		auto&      nodes = grid.nodes;
+		const Real alpha = damping, mf = massFloor;
+#pragma omp parallel for schedule(static)
+		for (size_t i = 0; i < nodes.size(); ++i) {
+			Node<D>&      nd  = nodes[i];
+			const uint8_t fix = grid.fixMask[i];
+			if (nd.m > mf) {
+				for (int a = 0; a < D; ++a) {
+					const Real v = nd.a[a] / nd.m;
+					Real       f = nd.b[a];
+					if (alpha > 0 && v != 0) f -= alpha * std::abs(f) * (v > 0 ? 1 : -1);
+					nd.a[a] = (fix >> a) & 1 ? 0.0 : v + dt * f / nd.m;
+				}
+			} else {
+				for (int a = 0; a < D; ++a) nd.a[a] = 0;
+			}
+			for (int a = 0; a < D; ++a) nd.b[a] = 0; // b collects the MUSL momentum next
+		}
+	}
+
+	// ---------------------------------------------------------------- G2P + MUSL remap: Eqs. 6–7, 16–17
+	// Particle velocity and its WLS gradient from the updated nodal velocities, then the particle's
+	// local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m.
+	void g2p()
+	{
+		auto&       nodes = grid.nodes;
+		ErrorRecord err;
+		scatterPass([&](size_t p) {
+			Stencil<D> st;
+			if (!stencilOf(p, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			Real v[D] = {}, C[D][D] = {};
+			for (int n = 0; n < N; ++n) {
+				const Node<D>& nd = nodes[st.base + offs.off[n]];
+				for (int a = 0; a < D; ++a) {
+					v[a] += st.psi[n] * nd.a[a]; // Eq. 6
+					for (int b = 0; b < D; ++b) C[a][b] += nd.a[a] * st.grad[n][b]; // Eq. 7
+				}
+			}
+			const Real m = P.mass[p];
+			for (int a = 0; a < D; ++a) {
+				P.v[a][p] = v[a];
+				for (int b = 0; b < D; ++b) P.C[a * D + b][p] = C[a][b];
+			}
+			for (int n = 0; n < N; ++n) {
+				Node<D>&   nd = nodes[st.base + offs.off[n]];
+				const Real wm = st.w[n] * m;
+				for (int a = 0; a < D; ++a) {
+					Real h = v[a];
+					for (int b = 0; b < D; ++b) h += C[a][b] * dxOf(st, n, b);
+					nd.b[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x_p)
+				}
+			}
+		});
+		throwIf(err, "G2P");
+	}
+	void gridMusl()
+	{
+		auto&      nodes = grid.nodes;
+		const Real mf    = massFloor;
+#pragma omp parallel for schedule(static)
+		for (size_t i = 0; i < nodes.size(); ++i) {
+			Node<D>&      nd  = nodes[i];
+			const uint8_t fix = grid.fixMask[i];
+			const Real    inv = nd.mw > mf ? 1.0 / nd.mw : 0.0; // Eq. 17 denominator
+			for (int a = 0; a < D; ++a) nd.b[a] = (fix >> a) & 1 ? 0.0 : nd.b[a] * inv;
+		}
+	}
+
+	// ---------------------------------------------------------------- stress update: Eqs. 7, 27–40
+	template <class Mat>
+	void updateStress(const Mat& mat, Real dt)
+	{
+		const auto& nodes = grid.nodes;
+		ErrorRecord err;
+		Real        vm = 0, rmin = INFINITY;
+		bool        drift = false;
+		const auto& blocks = sched.start;
+		const long  nb     = long(blocks.size()) - 1;
+		const Vec   lo = grid.origin, hi = grid.upper();
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : vm) reduction(min : rmin) reduction(|| : drift)
+		for (long b = 0; b < nb; ++b) {
+			for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
+				const size_t p = pp;
+				Stencil<D>   st;
+				if (!stencilOf(p, st)) {
+					err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+					continue;
+				}
+				Real L[D][D] = {}; // ∇v from the MUSL nodal velocities, Eq. 7
+				for (int n = 0; n < N; ++n) {
+					const Node<D>& nd = nodes[st.base + offs.off[n]];
+					for (int a = 0; a < D; ++a)
+						for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];
+				}
+				Sym<D> de;   // Δε = sym(∇v) Δt, Eq. 29
+				Sym<D> s = P.stress(p);
+				strainIncrement(L, dt, de);
+				jaumannRotation(L, dt, s);
+				mat.update(P, p, s, de, dt); // Eqs. 27–40
+				P.setStress(p, s);
+				const Real J = jacobian(L, dt);
+				P.vol[p] *= J;
+				Real sp = 0;
+				int  cell[D];
+				bool finite = s.finite() && J > 0 && std::isfinite(J);
+				for (int a = 0; a < D; ++a) {
+					P.x[a][p] += dt * P.v[a][p];
+					sp += P.v[a][p] * P.v[a][p];
+					finite = finite && std::isfinite(P.x[a][p]) && std::isfinite(P.v[a][p]);
+					cell[a] = int(std::floor((P.x[a][p] - lo[a]) / grid.spacing));
+				}
+				if (!finite) {
+					err.record(p, describeBad(p, s, J));
+					continue;
+				}
+				for (int a = 0; a < D; ++a)
+					if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
+						err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmt(P.x[a][p]) + " m (grid spans [" + fmt(lo[a]) + ", "
+						                      + fmt(hi[a]) + ") m)");
+						break;
+					}
+				vm   = std::max(vm, std::sqrt(sp));
+				rmin = std::min(rmin, P.mass[p] / P.vol[p]);
+				if (!sched.within(size_t(b), cell)) drift = true;
+			}
+		}
+		throwIf(err, "stress update");
+		vmax   = vm;
+		rhoMin = rmin;
+		if (drift) needSort = true;
+	}
+	std::string describeBad(size_t p, const Sym<D>& s, Real J) const
+	{
+		static const char* comp[6] = { "xx", "yy", "zz", "xy", "xz", "yz" };
+		for (int k = 0; k < NS; ++k)
+			if (!std::isfinite(s.c[k])) return std::string("has non-finite stress σ") + comp[k] + " = " + fmt(s.c[k]);
+		for (int a = 0; a < D; ++a)
+			if (!std::isfinite(P.v[a][p])) return "has non-finite velocity component " + std::to_string(a) + " = " + fmt(P.v[a][p]);
+		if (!(J > 0)) return "has non-positive volume change det(I + Δt∇v) = " + fmt(J) + " (element inverted)";
+		return "has a non-finite position";
+	}
+	static void strainIncrement(const Real (&L)[D][D], Real dt, Sym<D>& de)
+	{
+		de.c[0] = L[0][0] * dt;
+		de.c[1] = L[1][1] * dt;
+		de.c[2] = D == 3 ? L[D - 1][D - 1] * dt : 0.0; // plane strain: Δε_zz = 0
+		de.c[3] = 0.5 * (L[0][1] + L[1][0]) * dt;
+		if constexpr (D == 3) {
+			de.c[4] = 0.5 * (L[0][2] + L[2][0]) * dt;
+			de.c[5] = 0.5 * (L[1][2] + L[2][1]) * dt;
+		}
+	}
+	// Objective (Jaumann) rotation of the stress by the spin W = skew(∇v): σ += Δt(Wσ − σW).
+	static void jaumannRotation(const Real (&L)[D][D], Real dt, Sym<D>& s)
+	{
+		if constexpr (D == 2) {
+			const Real w  = 0.5 * (L[0][1] - L[1][0]) * dt; // W_xy
+			const Real sx = s.c[0], sy = s.c[1], sxy = s.c[3];
+			s.c[0] = sx + 2 * w * sxy;
+			s.c[1] = sy - 2 * w * sxy;
+			s.c[3] = sxy + w * (sy - sx);
+		} else {
+			Eigen::Matrix3d W, S = s.full();
+			for (int a = 0; a < 3; ++a)
+				for (int b = 0; b < 3; ++b) W(a, b) = 0.5 * (L[a][b] - L[b][a]) * dt;
+			S += W * S - S * W;
+			s = Sym<D>::fromFull(S);
+		}
+	}
+	static Real jacobian(const Real (&L)[D][D], Real dt)
+	{
+		if constexpr (D == 2) return (1 + L[0][0] * dt) * (1 + L[1][1] * dt) - L[0][1] * L[1][0] * dt * dt;
+		else {
+			Eigen::Matrix3d F;
+			for (int a = 0; a < 3; ++a)
+				for (int b = 0; b < 3; ++b) F(a, b) = (a == b) + L[a][b] * dt;
+			return F.determinant();
+		}
+	}
+
+	void accumulateExternalWork(Real dt)
+	{
+		const Real s = loadScale(time + dt);
+		Real       w = 0;
+		for (size_t p = 0; p < P.n; ++p)
+			for (int a = 0; a < D; ++a) w += (P.mass[p] * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0)) * P.v[a][p] * dt;
+		externalWork += w;
+	}
+};
+
+} // namespace mpm

@@ -1,0 +1,135 @@
+// Symmetric second-order tensors (stress, strain increment) in the compact storage of Dim<D>::nSym,
+// plus the closed-form principal decomposition used by the damage model and the output.
+#pragma once
+#include "MpmTypes.hpp"
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+
+namespace mpm {
+
+// Components: [0]=xx [1]=yy [2]=zz [3]=xy [4]=xz [5]=yz (the last two only in 3D).
+template <int D>
+struct Sym {
+	static constexpr int N = Dim<D>::nSym;
+	Real c[N];
+
+	static Sym zero()
+	{
+		Sym s;
+		for (int k = 0; k < N; ++k) s.c[k] = 0;
+		return s;
+	}
+	Real trace() const { return c[0] + c[1] + c[2]; }
+	Real mean() const { return trace() / 3.0; }
+	// Deviatoric part in place; returns the mean (σ_m = I1/3).
+	Real toDeviator()
+	{
+		Real m = mean();
+		c[0] -= m;
+		c[1] -= m;
+		c[2] -= m;
+		return m;
+	}
+	// s:s for a deviator (off-diagonals counted twice).
+	Real contract() const
+	{
+		Real r = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+		for (int k = 3; k < N; ++k) r += 2 * c[k] * c[k];
+		return r;
+	}
+	// τ = sqrt(J2) of a full tensor.
+	Real sqrtJ2() const
+	{
+		Sym d = *this;
+		d.toDeviator();
+		return std::sqrt(0.5 * d.contract());
+	}
+	bool finite() const
+	{
+		for (int k = 0; k < N; ++k)
+			if (!std::isfinite(c[k])) return false;
+		return true;
+	}
+	Eigen::Matrix3d full() const
+	{
+		Eigen::Matrix3d m;
+		m(0, 0) = c[0];
+		m(1, 1) = c[1];
+		m(2, 2) = c[2];
+		m(0, 1) = m(1, 0) = c[3];
+		m(0, 2) = m(2, 0) = (N > 4 ? c[N > 4 ? 4 : 0] : 0.0);
+		m(1, 2) = m(2, 1) = (N > 4 ? c[N > 5 ? 5 : 0] : 0.0);
+		return m;
+	}
+	static Sym fromFull(const Eigen::Matrix3d& m)
+	{
+		Sym s;
+		s.c[0] = m(0, 0);
+		s.c[1] = m(1, 1);
+		s.c[2] = m(2, 2);
+		s.c[3] = m(0, 1);
+		if constexpr (N > 4) {
+			s.c[N > 4 ? 4 : 0] = m(0, 2);
+			s.c[N > 5 ? 5 : 0] = m(1, 2);
+		}
+		return s;
+	}
+};
+
+// Principal values (descending) and, on request, directions of a symmetric tensor.
+// 2D plane strain: exact closed form of the in-plane 2×2 block plus σzz (xz = yz = 0).
+// 3D: Eigen's direct 3×3 solver.
+template <int D>
+struct Principal {
+	Real value[3];          // σ1 ≥ σ2 ≥ σ3
+	Eigen::Matrix3d vector; // columns match value[]
+
+	static Principal of(const Sym<D>& s)
+	{
+		Principal p;
+		if constexpr (D == 2) {
+			Real a = 0.5 * (s.c[0] + s.c[1]), b = 0.5 * (s.c[0] - s.c[1]);
+			Real r = std::sqrt(b * b + s.c[3] * s.c[3]);
+			Real l1 = a + r, l2 = a - r;
+			// in-plane direction of l1
+			Real th = 0.5 * std::atan2(2 * s.c[3], s.c[0] - s.c[1]);
+			Eigen::Vector3d e1(std::cos(th), std::sin(th), 0), e2(-std::sin(th), std::cos(th), 0), ez(0, 0, 1);
+			Real v[3]            = { l1, l2, s.c[2] };
+			Eigen::Vector3d e[3] = { e1, e2, ez };
+			int o[3]             = { 0, 1, 2 };
+			std::sort(o, o + 3, [&](int i, int j) { return v[i] > v[j]; });
+			for (int k = 0; k < 3; ++k) {
+				p.value[k]      = v[o[k]];
+				p.vector.col(k) = e[o[k]];
+			}
+		} else {
+			Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+			es.computeDirect(s.full());
+			for (int k = 0; k < 3; ++k) { // Eigen sorts ascending
+				p.value[k]      = es.eigenvalues()(2 - k);
+				p.vector.col(k) = es.eigenvectors().col(2 - k);
+			}
+		}
+		return p;
+	}
+	Sym<D> rebuild(const Real v[3]) const
+	{
+		Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+		for (int k = 0; k < 3; ++k) m += v[k] * vector.col(k) * vector.col(k).transpose();
+		return Sym<D>::fromFull(m);
+	}
+};
+
+// Largest principal value only (no directions): cheap, used for outputs and damage triggers.
+template <int D>
+inline Real maxPrincipal(const Sym<D>& s)
+{
+	if constexpr (D == 2) {
+		Real a = 0.5 * (s.c[0] + s.c[1]), b = 0.5 * (s.c[0] - s.c[1]);
+		return std::max(a + std::sqrt(b * b + s.c[3] * s.c[3]), s.c[2]);
+	} else {
+		return Principal<3>::of(s).value[0];
+	}
+}
+
+} // namespace mpm

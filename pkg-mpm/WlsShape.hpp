@@ -1,0 +1,129 @@
+// WLS shape functions with a linear basis and cubic B-spline weights (paper Sec. 2.2, Eqs. 8–15).
+//
+// For a particle whose 4^D stencil nodes are all active, the moment matrix of the cubic B-spline is
+// exactly M = diag(1, l²/3, …) (partition of unity, zero first moment, second moment 1/3 cell²), so
+// ψ_i = w_i and ∇ψ_i = w_i·3/l²·(x_i − x_p). Near the grid edge or when nodes are excluded, M is built
+// from the active nodes only and inverted: the fit stays exact for linear fields.
+#pragma once
+#include "Grid.hpp"
+#include <Eigen/LU>
+
+namespace mpm {
+
+// Cubic B-spline kernel w̃(t), Eq. 13 (t in cells).
+inline Real bspline3(Real t)
+{
+	t = std::abs(t);
+	if (t < 1) return 0.5 * t * t * t - t * t + 2.0 / 3.0;
+	if (t < 2) {
+		Real u = 2 - t;
+		return u * u * u / 6.0;
+	}
+	return 0;
+}
+
+template <int D>
+struct Stencil {
+	static constexpr int N = Dim<D>::nStencil;
+	size_t base;       // linear index of stencil node (0,0[,0])
+	Real   d[D][4];    // x_i − x_p per axis for the 4 stencil layers [m]
+	Real   w[N];       // B-spline weight w_i(x_p), Eq. 12
+	Real   psi[N];     // ψ_i(x_p), Eq. 15
+	Real   grad[N][D]; // ∇ψ_i(x_p)
+	bool   general;    // true when M was assembled from a reduced node set
+
+	// Offset of stencil node n from the base along each axis.
+	static int along(int n, int a) { return (n >> (2 * a)) & 3; }
+};
+
+// Linear-index offsets of the 4^D stencil nodes for a given grid (computed once per grid).
+template <int D>
+struct StencilOffsets {
+	size_t off[Dim<D>::nStencil];
+	explicit StencilOffsets(const Grid<D>& g)
+	{
+		for (int n = 0; n < Dim<D>::nStencil; ++n) {
+			size_t k = 0;
+			for (int a = 0; a < D; ++a) k += size_t(Stencil<D>::along(n, a)) * g.stride[a];
+			off[n] = k;
+		}
+	}
+	StencilOffsets() = default;
+};
+
+// Fills st for a particle at x. Returns false when the active nodes cannot support a linear fit
+// (singular moment matrix). The caller has checked that x lies inside the physical grid.
+template <int D>
+inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Stencil<D>& st)
+{
+	constexpr int N = Dim<D>::nStencil;
+	const Real    h = g.spacing, invH = 1.0 / g.spacing;
+	Real          w1[D][4];
+	int           cell[D];
+	bool          nearEdge = false;
+	size_t        base     = 0;
+	for (int a = 0; a < D; ++a) {
+		Real f  = (x[a] - g.origin[a]) * invH;
+		int  c  = int(std::floor(f));
+		cell[a] = c;
+		Real t  = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
+		Real u  = 1 - t;
+		w1[a][0] = u * u * u / 6.0;
+		w1[a][1] = 0.5 * t * t * t - t * t + 2.0 / 3.0;
+		w1[a][2] = 0.5 * u * u * u - u * u + 2.0 / 3.0;
+		w1[a][3] = t * t * t / 6.0;
+		for (int k = 0; k < 4; ++k) st.d[a][k] = (k - 1 - t) * h;
+		if (c - 1 < 0 || c + 2 > g.cells[a]) nearEdge = true;
+		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
+	}
+	st.base = base;
+	for (int n = 0; n < N; ++n) {
+		Real w = 1;
+		for (int a = 0; a < D; ++a) w *= w1[a][Stencil<D>::along(n, a)];
+		st.w[n] = w;
+	}
+	bool general = nearEdge;
+	if (!general && g.userExclusions())
+		for (int n = 0; n < N && !general; ++n) general = g.excluded[base + so.off[n]];
+	st.general = general;
+
+	if (!general) { // interior closed form: M⁻¹ = diag(1, 3/l², …)
+		const Real s = 3.0 * invH * invH;
+		for (int n = 0; n < N; ++n) {
+			st.psi[n] = st.w[n];
+			for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * s * st.d[a][Stencil<D>::along(n, a)];
+		}
+		return true;
+	}
+
+	// General case: moment matrix over active nodes (Eq. 10), basis p = [1, (x_i − x_p)/l] for conditioning.
+	using MatP = Eigen::Matrix<Real, D + 1, D + 1>;
+	using VecP = Eigen::Matrix<Real, D + 1, 1>;
+	MatP M = MatP::Zero();
+	VecP p[N];
+	for (int n = 0; n < N; ++n) {
+		if (g.excluded[base + so.off[n]]) st.w[n] = 0;
+		p[n][0] = 1;
+		for (int a = 0; a < D; ++a) p[n][a + 1] = st.d[a][Stencil<D>::along(n, a)] * invH;
+		if (st.w[n] != 0) M.noalias() += st.w[n] * p[n] * p[n].transpose();
+	}
+	// M is SPD when the active nodes span a D-simplex; its smallest scale is ~1e-2 in cell units.
+	Real det = M.determinant();
+	if (!(std::abs(det) > 1e-12)) {
+		for (int n = 0; n < N; ++n) {
+			st.psi[n] = 0;
+			for (int a = 0; a < D; ++a) st.grad[n][a] = 0;
+		}
+		return false;
+	}
+	MatP Minv = M.inverse();
+	for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient
+		VecP q    = Minv * p[n];
+		st.psi[n] = st.w[n] * q[0];
+		for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
+	}
+	(void)cell;
+	return true;
+}
+
+} // namespace mpm

@@ -1,0 +1,77 @@
+// C++ unit tests of the core that need no Python: WLS shape functions against the closed form and
+// linear reproduction, and one DP return landing on the yield surface.
+#include "Solver.hpp"
+#include <cstdio>
+#include <random>
+
+using namespace mpm;
+static int failures = 0;
+#define CHECK(cond, ...)                                                                                                                             \
+	do {                                                                                                                                         \
+		if (!(cond)) {                                                                                                                       \
+			std::printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                                             \
+			std::printf(__VA_ARGS__);                                                                                                    \
+			std::printf("\n");                                                                                                           \
+			++failures;                                                                                                                  \
+		}                                                                                                                                    \
+	} while (0)
+
+template <int D>
+void shapeChecks()
+{
+	typename Dim<D>::IVec n;
+	n.setConstant(12);
+	Grid<D>           g(Dim<D>::Vec::Zero(), 0.1, n);
+	StencilOffsets<D> so(g);
+	std::mt19937      rng(7);
+	std::uniform_real_distribution<double> U(0.0, 1.2 - 1e-9);
+	for (int trial = 0; trial < 500; ++trial) {
+		Real x[D];
+		for (int a = 0; a < D; ++a) x[a] = U(rng);
+		if (trial % 3 == 0) // sometimes exclude a random physical node
+			g.setExcluded(g.linear(Dim<D>::IVec::Constant(2 + trial % 13)), trial % 2);
+		Stencil<D> st;
+		CHECK(computeStencil(g, so, x, st), "stencil singular");
+		Real sum = 0, lin[D] = {}, grad1[D] = {}, gradLin[D][D] = {};
+		for (int k = 0; k < Dim<D>::nStencil; ++k) {
+			auto xi = g.position(st.base + so.off[k]);
+			sum += st.psi[k];
+			for (int a = 0; a < D; ++a) {
+				lin[a] += st.psi[k] * xi[a];
+				grad1[a] += st.grad[k][a];
+				for (int b = 0; b < D; ++b) gradLin[a][b] += xi[a] * st.grad[k][b];
+			}
+		}
+		CHECK(std::abs(sum - 1) < 1e-12, "partition of unity %g", sum);
+		for (int a = 0; a < D; ++a) {
+			CHECK(std::abs(lin[a] - x[a]) < 1e-12, "linear reproduction %g vs %g", lin[a], x[a]);
+			CHECK(std::abs(grad1[a]) < 1e-9, "gradient of constant %g", grad1[a]);
+			for (int b = 0; b < D; ++b) CHECK(std::abs(gradLin[a][b] - (a == b)) < 1e-9, "gradient of linear field %g", gradLin[a][b]);
+		}
+	}
+}
+
+void dpChecks()
+{
+	DpGkMat m;
+	m.young = 22.41e9, m.poisson = 0.2313, m.density = 2500, m.frictionAngle = 32.5 * M_PI / 180, m.dilatancyAngle = 8.125 * M_PI / 180;
+	m.cohesion = 24.8e6, m.critPlasticStrain = 0.1, m.weibullK = 1.1798e29, m.weibullM = 7.5, m.damage = false;
+	m.validate();
+	DruckerPragerGradyKipp<2> mat(m);
+	Sym<2>                    s = Sym<2>::zero();
+	s.c[0] = -200e6, s.c[1] = -20e6, s.c[2] = -50e6, s.c[3] = 30e6;
+	Real epsP = 0;
+	auto r    = mat.plasticReturn(s, epsP);
+	CHECK(r.mode == 1, "expected cone return, got %d", r.mode);
+	Real F = s.sqrtJ2() + mat.qphi * s.mean() - mat.kphi * m.cohesionAt(epsP);
+	CHECK(std::abs(F) < 1e-8 * m.cohesion, "on yield surface F = %g", F);
+}
+
+int main()
+{
+	shapeChecks<2>();
+	shapeChecks<3>();
+	dpChecks();
+	std::printf("%s (%d failures)\n", failures ? "FAILED" : "OK", failures);
+	return failures ? 1 : 0;
+}
