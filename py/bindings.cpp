@@ -257,6 +257,8 @@ struct SolverWrap {
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("requestSort", &S::requestSort)
+		        .def("elasticParameters", &S::elasticParameters, bp::return_value_policy<bp::copy_const_reference>())
+		        .def("dpgkParameters", &S::dpgkParameters, bp::return_value_policy<bp::copy_const_reference>())
 		        .def("loadScale", &S::loadScale)
 		        .add_property("numParticles", &numParticles)
 		        .add_property("bytesPerParticle", &bytesPerParticle)

@@ -1,0 +1,17 @@
+"""yade_mpm: weighted-least-squares material point method (WLS-MPM) for YADE.
+
+Core solver in C++ (pkg-mpm/, module ``yade_mpm._core``), driven from YADE's O.engines through
+``MpmEngine``. Quantities are SI; stress is tension-positive; 2D is plane strain per unit thickness.
+"""
+from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D
+from .materials import ElasticMat, DpGkMat
+from .scene import (make_solver, add_region, views, get, set_initial_stress, boundary_particles, apply_traction,
+                    SYM_NAMES)
+from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
+from .engine import MpmEngine, engine
+from .progress import Progress
+
+__all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
+           "make_solver", "add_region", "views", "get", "set_initial_stress", "boundary_particles",
+           "apply_traction", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine",
+           "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D"]

@@ -1,0 +1,65 @@
+"""The YADE hook. Debian ships YADE without C++ headers, so the MPM solver cannot be compiled as a
+YADE Engine subclass; it joins YADE's loop through YADE's own Python engine, a PyRunner with
+iterPeriod=1 and initRun=True placed in O.engines like any engine:
+
+    O.engines = [ForceResetter(), ..., MpmEngine(solver, label='mpm').runner(), NewtonIntegrator()]
+
+Each YADE iteration it advances the MPM particles by O.dt, lowering O.dt first when the MPM stable
+step requires it (and raising it back towards the step the user/DEM asked for when possible), so
+O.time and O.iter stay the simulation's clock. The PyRunner carries the label, and
+``yade_mpm.engine('mpm')`` returns this object from that label."""
+from .progress import Progress
+
+_registry = {}
+
+
+def engine(label):
+    """The MpmEngine registered under a YADE engine label."""
+    try:
+        return _registry[label]
+    except KeyError:
+        raise KeyError(f"no MPM engine labelled '{label}'; known: {sorted(_registry)}") from None
+
+
+class MpmEngine:
+    def __init__(self, solver, label="mpm", progress_interval=None, end_time=None):
+        """solver: a Solver2D/3D; label: YADE engine label; progress_interval: wall seconds between
+        progress lines (None = silent); end_time: simulated end time [s] for the ETA."""
+        if not isinstance(label, str) or not label.isidentifier():
+            raise ValueError(f"label = {label!r} must be a Python identifier (YADE exposes labels as names)")
+        self.solver, self.label = solver, label
+        self.user_dt = None       # the O.dt asked for by the user/DEM side
+        self.last_set_dt = None   # the O.dt this engine set last
+        self.error = None
+        self.progress = Progress(end_time, label, progress_interval) if progress_interval else None
+        _registry[label] = self
+
+    def runner(self):
+        """The PyRunner to place in O.engines (before NewtonIntegrator)."""
+        from yade.wrapper import PyRunner
+        cmd = f"__import__('yade_mpm').engine({self.label!r})._yade_step()"
+        return PyRunner(command=cmd, iterPeriod=1, initRun=True, label=self.label)
+
+    def _yade_step(self):
+        from yade import O
+        s = self.solver
+        try:
+            if s.steps == 0 and s.time == 0 and O.time != 0:
+                s.time = O.time
+            if self.user_dt is None or O.dt != self.last_set_dt:
+                self.user_dt = O.dt  # someone else (user, DEM time stepper) set O.dt
+            if s.autoDt:
+                dt = min(self.user_dt, s.stableDt())
+            else:
+                dt = min(self.user_dt, s.fixedDt)
+            if dt != O.dt:
+                O.dt = dt
+            self.last_set_dt = O.dt
+            s.advance(O.dt)
+        except Exception as e:  # stop YADE cleanly with the message instead of stepping on
+            self.error = e
+            O.pause()
+            print(f"[{self.label}] MPM stopped: {e}", flush=True)
+            raise
+        if self.progress:
+            self.progress.update(s.steps, s.time)

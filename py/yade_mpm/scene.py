@@ -1,0 +1,136 @@
+"""Building a scene: a solver whose grid covers a region, particles from geometry, in-situ stress,
+surface tractions, and id-ordered copies of particle fields for post-processing."""
+import numpy as np
+from . import _core
+from .geometry import fill_region
+
+SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz")}
+
+
+def make_solver(lo, hi, spacing, margin=2):
+    """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
+    on every side, with grid spacing l = spacing [m]."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    if lo.shape != hi.shape or len(lo) not in (2, 3):
+        raise ValueError("lo and hi must both have 2 (plane strain) or 3 components")
+    if not (np.isfinite(spacing) and spacing > 0):
+        raise ValueError(f"spacing = {spacing} m must be finite and > 0")
+    if int(margin) != margin or margin < 0:
+        raise ValueError(f"margin = {margin} cells must be an integer ≥ 0")
+    cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin)
+    origin = lo - margin * spacing
+    cls = _core.Solver2D if len(lo) == 2 else _core.Solver3D
+    return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells))
+
+
+def dim_of(solver):
+    return 2 if isinstance(solver, _core.Solver2D) else 3
+
+
+def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None):
+    """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2);
+    assigns the material to the solver. Returns the storage indices range start (particle ids)."""
+    x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
+    first = solver.numParticles
+    solver.setMaterial(material)
+    solver.addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density))
+    return np.arange(first, first + len(x))
+
+
+def views(solver):
+    """Live NumPy views (storage order, no copy) of every allocated particle field, keyed by name:
+    x0.., v0.., sig0.. (xx, yy, zz, xy[, xz, yz]), mass, vol, id, epsP, damage… The storage order
+    changes when particles are re-sorted; `id` tells which particle sits in each slot."""
+    d = dim_of(solver)
+    names = [f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
+    names += ["mass", "vol", "vol0", "id", "epsP", "damage", "eps0"]
+    out = {}
+    for n in names:
+        try:
+            out[n] = solver.view(n)
+        except ValueError:
+            pass
+    return out
+
+
+def _order(solver):
+    return np.argsort(solver.view("id"), kind="stable")
+
+
+def get(solver, name):
+    """Copy of a particle field in particle-id order. Names: pos, vel, stress (the stress carried,
+    damaged for DP–GK; components xx, yy, zz, xy[, xz, yz], tension positive, [Pa]), state_stress,
+    max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass, volume, id."""
+    o = _order(solver)
+    d = dim_of(solver)
+    if name == "pos":
+        return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
+    if name == "vel":
+        return np.column_stack([solver.view(f"v{a}") for a in range(d)])[o]
+    if name == "stress":
+        return solver.effectiveStress()[o]
+    if name == "state_stress":
+        return np.column_stack([solver.view(f"sig{k}") for k in range(len(SYM_NAMES[d]))])[o]
+    if name == "max_principal_stress":
+        return solver.maxPrincipalStress()[o]
+    if name == "damage":
+        return _optional(solver, "damage")[o]
+    if name == "plastic_strain":
+        return _optional(solver, "epsP")[o]
+    if name == "cohesion":
+        if solver.materialKind != 1:
+            raise ValueError("cohesion exists only for the DP–GK material")
+        m = solver.dpgkParameters()
+        eps = _optional(solver, "epsP")[o]
+        return np.maximum(m.cohesion * (1 - eps / m.critPlasticStrain), m.residualCohesion * m.cohesion)  # Eq. 34
+    if name == "mass":
+        return solver.view("mass")[o].copy()
+    if name == "volume":
+        return solver.view("vol")[o].copy()
+    if name == "id":
+        return solver.view("id")[o].copy()
+    raise ValueError(f"unknown field '{name}'")
+
+
+def _optional(solver, name):
+    try:
+        return solver.view(name)
+    except ValueError:
+        return np.zeros(solver.numParticles)
+
+
+def set_initial_stress(solver, stress):
+    """In-situ stress for every particle: components (xx, yy, zz, xy[, xz, yz]) [Pa], tension positive."""
+    d = dim_of(solver)
+    stress = np.asarray(stress, float)
+    n = len(SYM_NAMES[d])
+    if stress.shape != (n,) or not np.all(np.isfinite(stress)):
+        raise ValueError(f"initial stress must be {n} finite components {SYM_NAMES[d]} [Pa]")
+    for k in range(n):
+        solver.view(f"sig{k}")[:] = stress[k]
+    solver.requestSort()
+
+
+def boundary_particles(solver, axis, side, tol=None):
+    """Storage indices of the particle layer nearest the region face `side` (-1 low, +1 high) of `axis`."""
+    x = solver.view(f"x{axis}")
+    d = solver.spacing / 2 if tol is None else tol
+    edge = x.min() if side < 0 else x.max()
+    return np.nonzero(np.abs(x - edge) < 0.5 * d)[0]
+
+
+def apply_traction(solver, indices, traction, area):
+    """Prescribed traction t [Pa] on particle faces of area `area` [m² per particle; in 2D face length
+    × 1 m]: adds the surface force t·area to each particle (Eq. 22). Indices are storage slots; call
+    before stepping (the solver re-sorts particles but carries the forces with them)."""
+    d = dim_of(solver)
+    t = np.broadcast_to(np.asarray(traction, float), (len(indices), d))
+    if not np.all(np.isfinite(t)):
+        raise ValueError("traction must be finite [Pa]")
+    if not area > 0:
+        raise ValueError(f"area = {area} m² must be > 0")
+    try:
+        old = np.column_stack([solver.view(f"trac{a}")[indices] for a in range(d)])
+    except ValueError:
+        old = 0.0
+    solver.setParticleForces(np.asarray(indices, np.int64), old + t * area)

@@ -1,0 +1,23 @@
+#!/bin/bash
+# Installs the Debian packages yade-mpm needs (when missing), builds the C++ core and its Python
+# module, and makes `import yade` and `import yade_mpm` work for /usr/bin/python3 and for `yade`.
+set -euo pipefail
+cd "$(dirname "$0")"
+PKGS="yade libeigen3-dev libboost-python-dev libboost-numpy-dev python3-numpy python3-pytest python3-matplotlib cmake g++ make"
+missing=""
+for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
+if [ -n "$missing" ]; then
+	echo "[setup] installing:$missing"
+	apt-get update -qq
+	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
+fi
+# Debian's /usr/lib/python3/dist-packages/yade points to a missing directory; YADE's modules live in
+# yade-double/py. .pth files in the site directory put both YADE and this checkout's py/ on sys.path.
+site=$(/usr/bin/python3 -c 'import site; print([p for p in site.getsitepackages() if p.startswith("/usr/local")][0])')
+mkdir -p "$site"
+echo /usr/lib/x86_64-linux-gnu/yade-double/py > "$site/yade-double.pth"
+echo "$(pwd)/py" > "$site/yade_mpm.pth"
+cmake -S . -B build -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build -j2 2>&1 | grep -E "error|warning" || true
+test -f py/yade_mpm/_core*.so || { echo "[setup] build failed"; exit 1; }
+echo "[setup] ready: $(cd / && /usr/bin/python3 -c 'import yade, yade_mpm; print("yade", yade.__file__, "| yade_mpm", yade_mpm.__file__)' 2>&1 | tail -1)"
