@@ -17,6 +17,8 @@ site=$(/usr/bin/python3 -c 'import site; print([p for p in site.getsitepackages(
 mkdir -p "$site"
 echo /usr/lib/x86_64-linux-gnu/yade-double/py > "$site/yade-double.pth"
 echo "$(pwd)/py" > "$site/yade_mpm.pth"
+exec 9>/tmp/yade-mpm-build.lock
+flock 9   # several checkouts/processes may build at once
 cmake -S . -B build -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j2 2>&1 | grep -E "error|warning" || true
 test -f py/yade_mpm/_core*.so || { echo "[setup] build failed"; exit 1; }
