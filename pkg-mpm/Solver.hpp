@@ -80,7 +80,10 @@ public:
 			P.mass[old + p]                  = mass[p];
 			P.id[old + p]                    = int64_t(old + p);
 		}
-		if (kind == MaterialKind::DruckerPragerGradyKipp) initDamageThresholds(old);
+		if (kind == MaterialKind::DruckerPragerGradyKipp) {
+			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
+			initDamageThresholds(old);
+		}
 		needSort = true;
 	}
 
@@ -272,7 +275,7 @@ private:
 				for (int a = 0; a < D; ++a) sp += P.v[a][p] * P.v[a][p];
 				vmax = std::max(vmax, std::sqrt(sp));
 			}
-			massFloor = 1e-9 * mmin; // nodes lighter than this carry no velocity
+			massFloor = 1e-14 * mmin; // nodes lighter than this carry no velocity (only roundoff-level mass)
 		}
 	}
 

@@ -1,0 +1,34 @@
+"""Small scene builders shared by the foundation tests."""
+import numpy as np
+import yade_mpm as ym
+
+ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
+
+
+def bar_2d(cells_x=64, cells_y=4, length=1.0, mat=None, ppc=2):
+    """A bar [0, length] × [0, cells_y·l] filling the grid between fixed ends (x) and slip faces (y):
+    one-dimensional strain, so waves travel at √((K + 4G/3)/ρ)."""
+    h = length / cells_x
+    s = ym.Solver2D((-2 * h, 0.0), h, (cells_x + 4, cells_y))
+    m = mat or ym.ElasticMat(young=1e9, poisson=0.25, density=1000.0)
+    ym.add_region(s, m, (0.0, 0.0), (length, cells_y * h), ppc=ppc)
+    s.addBoundaryPlane(0, -1, 0.0, "fixed")
+    s.addBoundaryPlane(0, 1, length, "fixed")
+    s.addBoundaryPlane(1, -1, 0.0, "slip")
+    s.addBoundaryPlane(1, 1, cells_y * h, "slip")
+    return s, m
+
+
+def set_velocity(s, fn):
+    """Velocity field fn(pos (N, D)) -> (N, D) written into the live views."""
+    d = 2 if isinstance(s, ym.Solver2D) else 3
+    pos = np.column_stack([s.view(f"x{a}") for a in range(d)])
+    v = fn(pos)
+    for a in range(d):
+        s.view(f"v{a}")[:] = v[:, a]
+    s.requestSort()
+
+
+def total_momentum(s, d=2):
+    m = s.view("mass")
+    return np.array([np.sum(m * s.view(f"v{a}")) for a in range(d)])
