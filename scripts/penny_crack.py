@@ -1,0 +1,354 @@
+"""Penny-shaped (line) crack under internal pressure, paper Sec. 3.2 (Figs. 7–9).
+
+Plane strain square of side L with a 2c = 0.4 m line crack at its centre, made by removing the particles
+of two cell layers; the crack faces carry the pressure P as a particle traction. Three parts:
+
+  elastic      P = 15 MPa, elastic rock, quasi-static (ramp + Cundall damping): u_y along the crack vs
+               Sneddon (Eq. 43), σ ahead of the tip vs Eq. 44.
+  convergence  the elastic run at several grid spacings: error against wall time.
+  damage       DP–GK rock, P = 75 MPa ramped linearly: crack extension Δa(t) [cells] vs the paper's
+               7, 22, 72 cells at t = 0.1, 0.2, 0.4 s; damage fields; plastic particle count.
+
+The paper ramps P over 0.5 s (≈ 160 k steps at l = 0.02 m). The load is quasi-static (the P-wave
+crosses the 5 m block in 1.5 ms), so by default the ramp is compressed to --ramp-time seconds and
+results are reported on the paper's time axis t_paper = t · 0.5 s / ramp-time (= the same pressure
+P(t)). `--full` runs the paper's 0.5 s ramp (hours). summary.json says which configuration ran.
+
+    /usr/bin/python3 scripts/penny_crack.py --out out/penny            # default
+    /usr/bin/python3 scripts/penny_crack.py --out out/penny --full     # paper time scale
+"""
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+import yade_mpm as ym
+import yade_mpm.output as out
+from yade_mpm import sneddon
+
+# Paper Sec. 3.2 rock
+ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
+DPGK = dict(frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
+            critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
+HALF_CRACK = 0.2                       # c [m]
+PAPER_RAMP = 0.5                       # s
+PAPER_DA = [(0.1, 7), (0.2, 22), (0.4, 72)]   # Fig. 9: (t [s], Δa [cells of 0.02 m])
+PAPER_CELL = 0.02                      # m
+SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
+
+
+def build(size, h, material, P, ramp, damping):
+    """Solver with the cracked block; returns (solver, crack geometry dict)."""
+    s = ym.make_solver((0, 0), (size, size), h, margin=2)
+    xc = yc = round(size / 2 / h) * h   # crack centre on a grid line so the hole is exactly two cell layers
+    crack = ym.Box((xc - HALF_CRACK, yc - h), (xc + HALF_CRACK, yc + h))  # two cell layers
+    ym.add_region(s, material, (0, 0), (size, size), ppc=2, holes=[crack])
+    x0 = ym.get(s, "pos")               # ids == storage slots before the first step
+    dp = h / 2                          # particle spacing
+    along = np.abs(x0[:, 0] - xc) < HALF_CRACK
+    top = along & (np.abs(x0[:, 1] - (yc + h + dp / 2)) < dp / 4)
+    bot = along & (np.abs(x0[:, 1] - (yc - h - dp / 2)) < dp / 4)
+    # pressure P on the faces: traction −P n, n the outward normal of the solid (−y on the upper face)
+    ym.apply_traction(s, np.nonzero(top)[0], (0.0, P), dp)
+    ym.apply_traction(s, np.nonzero(bot)[0], (0.0, -P), dp)
+    s.damping = damping
+    s.tractionRampTime = ramp
+    geo = dict(xc=xc, yc=yc, h=h, dp=dp, x0=x0, top=np.nonzero(top)[0], bot=np.nonzero(bot)[0])
+    return s, geo
+
+
+def face_opening(s, geo):
+    """Half crack opening (u_top − u_bot)/2 per column along the crack: (x − xc, u_y)."""
+    u = ym.get(s, "pos") - geo["x0"]
+    t, b = geo["top"], geo["bot"]
+    ot, ob = np.argsort(geo["x0"][t, 0]), np.argsort(geo["x0"][b, 0])
+    x = geo["x0"][t[ot], 0] - geo["xc"]
+    return x, 0.5 * (u[t[ot], 1] - u[b[ob], 1])
+
+
+def run_elastic(size, h, P, args, label):
+    """Quasi-static elastic run; returns a dict of profiles and errors."""
+    mat = ym.ElasticMat(**ROCK)
+    cp = math.sqrt((mat.young * (1 - mat.poisson) / ((1 + mat.poisson) * (1 - 2 * mat.poisson))) / mat.density)
+    transit = size / cp
+    s, geo = build(size, h, mat, P, ramp=2 * transit, damping=args.elastic_damping)
+    t0 = time.time()
+    prog = ym.Progress(args.elastic_max_transits * transit, f"elastic h={h}", args.progress)
+    ref = sneddon.opening_displacement(0.0, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
+    last = None
+    while s.time < args.elastic_max_transits * transit:
+        t_next = s.time + 0.5 * transit
+        while s.time < t_next:
+            s.step()
+        prog.update(s.steps, s.time)
+        _, uy = face_opening(s, geo)
+        cur = uy.max()
+        # converged once the load is on and the opening changes < tol (relative to Sneddon) per ½ transit
+        if s.time > 2 * transit and last is not None and abs(cur - last) < args.elastic_tol * ref:
+            break
+        last = cur
+    wall = time.time() - t0
+    x, uy = face_opening(s, geo)
+    ua = sneddon.opening_displacement(x, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
+    centre = np.argsort(np.abs(x))[:2]
+    uy_centre_err = (uy[centre].mean() - ua[centre].mean()) / ua[centre].mean()
+    uy_l2 = math.sqrt(np.sum((uy - ua) ** 2) / np.sum(ua ** 2))
+    # σ on the crack line ahead of both tips: the two particle rows at y = yc ± dp/2
+    pos, st = geo["x0"], ym.get(s, "stress")
+    line = np.abs(pos[:, 1] - geo["yc"]) < geo["dp"] * 0.75
+    xr = pos[line, 0] - geo["xc"]
+    ahead = np.abs(xr) > HALF_CRACK
+    xa = np.abs(xr[ahead])
+    syy, sxx = st[line, 1][ahead], st[line, 0][ahead]
+    order = np.argsort(xa)
+    xa, syy, sxx = xa[order], syy[order], sxx[order]
+    # mean over the 4 particles (2 rows × 2 tips) at each |x|
+    xu, inv = np.unique(np.round(xa, 9), return_inverse=True)
+    syy_m = np.bincount(inv, syy) / np.bincount(inv)
+    sxx_m = np.bincount(inv, sxx) / np.bincount(inv)
+    sa = sneddon.stress_ahead(xu, P, HALF_CRACK)
+    far = (xu > HALF_CRACK + 2 * h) & (xu < HALF_CRACK + 1.0)   # beyond the smoothed tip zone
+    syy_l2 = math.sqrt(np.sum((syy_m[far] - sa[far]) ** 2) / np.sum(sa[far] ** 2))
+    return dict(h=h, size=size, particles=s.numParticles, steps=s.steps, t=s.time, wall=wall,
+                uy_centre_err=uy_centre_err, uy_l2=uy_l2, syy_l2_far=syy_l2, x=x, uy=uy, ua=ua,
+                xs=xu, syy=syy_m, sxx=sxx_m, sa=sa, ke=s.kineticEnergy())
+
+
+def crack_extension(s, geo, band):
+    """Δa [cells of this grid] at the left and right tips: contiguous columns of grid cells beyond the
+    initial tip holding at least one fully damaged (D = 1) particle within |y − yc| < band."""
+    pos, dmg = ym.get(s, "pos"), ym.get(s, "damage")
+    h = geo["h"]
+    broken = (dmg >= 1.0) & (np.abs(pos[:, 1] - geo["yc"]) < band)
+    res = []
+    for side in (-1, 1):
+        d = side * (pos[broken, 0] - geo["xc"]) - HALF_CRACK
+        cols = set(np.floor(d[d >= 0] / h).astype(int).tolist())
+        k = 0
+        while k in cols:
+            k += 1
+        res.append(k)
+    return res
+
+
+def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
+    plt = out.pyplot()
+    pos, dmg = ym.get(s, "pos"), ym.get(s, "damage")
+    m = (np.abs(pos[:, 0] - geo["xc"]) < half_width) & (np.abs(pos[:, 1] - geo["yc"]) < half_height)
+    fig, ax = plt.subplots(figsize=(9, 3.2))
+    sc = ax.scatter(pos[m, 0], pos[m, 1], c=dmg[m], s=0.3, cmap="jet", vmin=0, vmax=1, marker="s", linewidths=0)
+    fig.colorbar(sc, ax=ax, label="damage D")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def run_damage(args, law, outdir):
+    size, h = args.size, args.damage_spacing
+    ramp = PAPER_RAMP if args.full else args.ramp_time
+    scale = PAPER_RAMP / ramp                                  # t_paper = scale · t
+    mat = ym.DpGkMat(**ROCK, **DPGK, growthLaw=law)
+    s, geo = build(size, h, mat, args.damage_pressure, ramp=ramp, damping=args.damage_damping)
+    t_end = args.end_time / scale
+    rec_dt = args.record_every / scale
+    prog = ym.Progress(t_end, f"damage law {law}", args.progress)
+    rows, snaps = [], list(SNAP_T)
+    t0 = time.time()
+    next_rec = 0.0
+    while s.time < t_end:
+        s.step()
+        prog.update(s.steps, s.time)
+        tp = s.time * scale
+        if s.time >= next_rec or s.time >= t_end:
+            left, right = crack_extension(s, geo, args.band)
+            dm = s.view("damage")
+            rows.append((tp, args.damage_pressure * min(1.0, s.time / ramp), left, right,
+                         int(np.count_nonzero(dm >= 1)), int(np.count_nonzero(dm > 0)),
+                         int(np.count_nonzero(s.view("epsP") > 0)), time.time() - t0))
+            next_rec += rec_dt
+        while snaps and tp >= snaps[0] - 1e-12:
+            tag = f"law{law}_t{snaps[0]:.2f}s"
+            damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
+                       f"D, growth law {law}, t_paper = {snaps[0]} s (P = {args.damage_pressure * snaps[0] / PAPER_RAMP / 1e6:.0f} MPa)")
+            if args.vtu:
+                out.write_particles(os.path.join(outdir, f"damage_{tag}.vtu"), s)
+            snaps.pop(0)
+    wall = time.time() - t0
+    header = ["t_paper_s", "P_Pa", "da_left_cells", "da_right_cells", "broken_particles", "damaged_particles",
+              "plastic_particles", "wall_s"]
+    out.write_csv(os.path.join(outdir, f"crack_extension_law{law}.csv"), header, rows)
+    plastic = int(np.count_nonzero(s.view("epsP") > 0))
+    return dict(law=law, rows=rows, wall=wall, particles=s.numParticles, steps=s.steps, plastic=plastic,
+                ramp=ramp, scale=scale, h=h, size=size)
+
+
+def interp_da(rows, t):
+    """Δa (left, right) of the last record at or before paper time t."""
+    best = None
+    for r in rows:
+        if r[0] <= t + 1e-9:
+            best = r
+    return (best[2], best[3]) if best else (0, 0)
+
+
+def plot_elastic(e, outdir, P):
+    plt = out.pyplot()
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    xf = np.linspace(-HALF_CRACK, HALF_CRACK, 201)
+    ax[0].plot(xf, 1e3 * sneddon.opening_displacement(xf, P, ROCK["young"], ROCK["poisson"], HALF_CRACK), "k-",
+               label="Sneddon (Eq. 43)")
+    ax[0].plot(e["x"], 1e3 * e["uy"], "s", mfc="none", ms=4, label=f"MPM, l = {e['h']} m")
+    ax[0].set_xlabel("x − x_c [m]")
+    ax[0].set_ylabel("u_y [mm]")
+    ax[0].legend()
+    xs = np.linspace(HALF_CRACK * 1.0005, HALF_CRACK + 1.0, 400)
+    ax[1].plot(xs, sneddon.stress_ahead(xs, P, HALF_CRACK) / 1e6, "k-", label="Eq. 44")
+    ax[1].plot(e["xs"], e["syy"] / 1e6, "s", mfc="none", ms=4, label="MPM σ_yy")
+    ax[1].plot(e["xs"], e["sxx"] / 1e6, "o", mfc="none", ms=3, label="MPM σ_xx")
+    ax[1].set_xlim(HALF_CRACK, HALF_CRACK + 1.0)
+    ax[1].set_ylim(-5, 45)
+    ax[1].set_xlabel("|x − x_c| [m]")
+    ax[1].set_ylabel("σ [MPa]")
+    ax[1].legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "elastic_profiles.png"), dpi=150)
+    plt.close(fig)
+
+
+def plot_convergence(conv, outdir):
+    plt = out.pyplot()
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    w = [c["wall"] for c in conv]
+    ax.loglog(w, [abs(c["uy_centre_err"]) for c in conv], "o-", label="|u_y centre error|")
+    ax.loglog(w, [c["uy_l2"] for c in conv], "s-", label="u_y rel. L2 error")
+    for c in conv:
+        ax.annotate(f"l={c['h']}", (c["wall"], c["uy_l2"]), fontsize=8)
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("relative error")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "error_vs_walltime.png"), dpi=150)
+    plt.close(fig)
+
+
+def plot_da(results, outdir):
+    plt = out.pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for r in results:
+        t = [row[0] for row in r["rows"]]
+        cells = PAPER_CELL / r["h"]
+        ax.plot(t, [0.5 * (row[2] + row[3]) / cells for row in r["rows"]], "-",
+                label=f"MPM, growth law {r['law']} ({'ε̄^(m/3)' if r['law'] == 0 else 'ε̄^(1/3), as printed'})")
+    ax.plot([p[0] for p in PAPER_DA], [p[1] for p in PAPER_DA], "ks", label="paper Fig. 9")
+    ax.set_xlabel("t (paper time scale) [s]")
+    ax.set_ylabel("Δa [cells of 0.02 m]")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "crack_extension.png"), dpi=150)
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", required=True, help="output directory")
+    ap.add_argument("--parts", default="elastic,convergence,damage", help="comma list of elastic, convergence, damage")
+    ap.add_argument("--size", type=float, default=5.0, help="side of the square block L [m] (paper 5.0)")
+    ap.add_argument("--spacing", type=float, default=0.04, help="grid spacing of the elastic run [m] (paper 0.02)")
+    ap.add_argument("--conv-spacings", default="0.08,0.04", help="grid spacings of the convergence study [m]")
+    ap.add_argument("--elastic-pressure", type=float, default=15e6, help="P of the elastic run [Pa]")
+    ap.add_argument("--elastic-damping", type=float, default=0.3, help="local damping of the quasi-static elastic run")
+    ap.add_argument("--elastic-tol", type=float, default=2e-4, help="stop when the opening changes < tol·u_Sneddon per half transit")
+    ap.add_argument("--elastic-max-transits", type=float, default=60, help="time limit of the elastic run [P-wave transits of L]")
+    ap.add_argument("--damage-spacing", type=float, default=0.02, help="grid spacing of the damage run [m] (paper 0.02)")
+    ap.add_argument("--damage-pressure", type=float, default=75e6, help="final P of the damage run [Pa]")
+    ap.add_argument("--damage-damping", type=float, default=0.05, help="local damping of the damage run")
+    ap.add_argument("--ramp-time", type=float, default=0.02, help="simulated ramp time replacing the paper's 0.5 s [s]")
+    ap.add_argument("--end-time", type=float, default=0.4, help="end of the damage run on the paper time axis [s]")
+    ap.add_argument("--record-every", type=float, default=0.005, help="Δa record interval on the paper time axis [s]")
+    ap.add_argument("--laws", default="0,1", help="damage growth laws to run: 0 = ε̄^(m/3) (default law), 1 = Eq. 38 as printed")
+    ap.add_argument("--band", type=float, default=0.2, help="half height of the band around the crack line searched for D = 1 [m]")
+    ap.add_argument("--full", action="store_true", help="paper configuration: 0.5 s ramp, l = 0.02 m elastic run (hours)")
+    ap.add_argument("--vtu", action="store_true", help="also write VTU particle files of the damage snapshots")
+    ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
+    ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
+    a = ap.parse_args(argv)
+    parts = set(a.parts.split(","))
+    if not parts <= {"elastic", "convergence", "damage"}:
+        ap.error(f"--parts: unknown part in {a.parts}; allowed elastic, convergence, damage")
+    for name in ("size", "spacing", "damage_spacing", "ramp_time", "end_time", "record_every", "band"):
+        if not getattr(a, name) > 0:
+            ap.error(f"--{name.replace('_', '-')} must be > 0")
+    if not 0 < a.end_time <= PAPER_RAMP:
+        ap.error(f"--end-time must lie in (0, {PAPER_RAMP}] s")
+    if a.full:
+        a.spacing = 0.02
+    if a.threads > 0:
+        ym.setThreads(a.threads)
+    os.makedirs(a.out, exist_ok=True)
+    summary = dict(config=dict(size_m=a.size, elastic_spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
+                               ramp_time_s=PAPER_RAMP if a.full else a.ramp_time, paper_ramp_s=PAPER_RAMP,
+                               full=a.full, elastic_damping=a.elastic_damping, damage_damping=a.damage_damping,
+                               elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
+                               threads=ym.getThreads()))
+    wall0 = time.time()
+    particles = 0
+    if "elastic" in parts:
+        e = run_elastic(a.size, a.spacing, a.elastic_pressure, a, "elastic")
+        particles = max(particles, e["particles"])
+        out.write_csv(os.path.join(a.out, "elastic_uy.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
+                      zip(e["x"], e["uy"], e["ua"]))
+        out.write_csv(os.path.join(a.out, "elastic_stress_ahead.csv"), ["abs_x_minus_xc_m", "syy_mpm_Pa", "sxx_mpm_Pa", "s_eq44_Pa"],
+                      zip(e["xs"], e["syy"], e["sxx"], e["sa"]))
+        plot_elastic(e, a.out, a.elastic_pressure)
+        summary.update(uy_center_rel_error=e["uy_centre_err"], uy_l2_rel_error=e["uy_l2"],
+                       syy_ahead_l2_rel_error=e["syy_l2_far"], elastic_wall_time_s=e["wall"],
+                       elastic_particles=e["particles"], elastic_steps=e["steps"], elastic_time_s=e["t"],
+                       elastic_final_kinetic_energy_J=e["ke"])
+        print(f"elastic l={a.spacing}: u_y centre error {e['uy_centre_err']:+.4f}, L2 {e['uy_l2']:.4f}, "
+              f"σyy L2 (2 cells..1 m ahead) {e['syy_l2_far']:.4f}, wall {e['wall']:.1f} s", flush=True)
+    if "convergence" in parts:
+        conv = []
+        for h in [float(v) for v in a.conv_spacings.split(",")]:
+            c = e if ("elastic" in parts and abs(h - a.spacing) < 1e-12) else run_elastic(a.size, h, a.elastic_pressure, a, "conv")
+            conv.append(c)
+            print(f"convergence l={h}: centre {c['uy_centre_err']:+.4f}, L2 {c['uy_l2']:.4f}, wall {c['wall']:.1f} s", flush=True)
+        out.write_csv(os.path.join(a.out, "error_vs_walltime.csv"),
+                      ["spacing_m", "particles", "steps", "wall_s", "uy_center_rel_error", "uy_l2_rel_error", "syy_ahead_l2_rel_error"],
+                      [(c["h"], c["particles"], c["steps"], c["wall"], c["uy_centre_err"], c["uy_l2"], c["syy_l2_far"]) for c in conv])
+        plot_convergence(conv, a.out)
+        summary["convergence"] = [dict(spacing_m=c["h"], particles=c["particles"], wall_time_s=c["wall"],
+                                       uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
+    if "damage" in parts:
+        results = []
+        for law in [int(v) for v in a.laws.split(",")]:
+            r = run_damage(a, law, a.out)
+            results.append(r)
+            particles = max(particles, r["particles"])
+            table = [dict(t_s=t, left=interp_da(r["rows"], t)[0], right=interp_da(r["rows"], t)[1])
+                     for t in [0.05, 0.1, 0.2, 0.3, 0.4] if t <= a.end_time + 1e-9]
+            summary[f"damage_law{law}"] = dict(crack_extension_cells=table, plastic_particles=r["plastic"],
+                                               wall_time_s=r["wall"], steps=r["steps"], ramp_time_s=r["ramp"],
+                                               spacing_m=r["h"], particles=r["particles"])
+            print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
+                  + f"; plastic {r['plastic']}; wall {r['wall']:.0f} s", flush=True)
+        plot_da(results, a.out)
+        first = summary[f"damage_law{results[0]['law']}"]
+        summary["default_law"] = results[0]["law"]
+        summary["crack_extension_cells"] = first["crack_extension_cells"]
+        summary["plastic_particles"] = first["plastic_particles"]
+        summary["paper_crack_extension_cells"] = [dict(t_s=t, cells=n) for t, n in PAPER_DA]
+    summary["wall_time_s"] = time.time() - wall0
+    summary["particles"] = particles
+    out.write_summary(a.out, summary)
+    return summary
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
