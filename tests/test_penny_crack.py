@@ -1,0 +1,77 @@
+"""Pressurised line crack (paper Sec. 3.2) on reduced set-ups that run in seconds: the elastic opening
+against Sneddon (Eq. 43) and the stress ahead of the tip against Eq. 44; crack growth from both tips
+with the DP–GK rock. The full-size numbers come from scripts/penny_crack.py (doc/penny_crack.md)."""
+import json
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+import yade_mpm as ym
+from yade_mpm import sneddon
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+import penny_crack  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def one_thread():
+    # these runs are small: one thread avoids OpenMP oversubscription on a busy 2-core machine
+    n = ym.getThreads()
+    ym.setThreads(1)
+    yield
+    ym.setThreads(n)
+
+
+def test_sneddon_formulas():
+    E, nu, P, c = 22.41e9, 0.2313, 15e6, 0.2
+    # Eq. 43 with a = c is the ellipse 2P(1 − ν²)/E √(c² − x²); zero at and beyond the tips
+    assert sneddon.opening_displacement(0.0, P, E, nu, c) == pytest.approx(2 * P * (1 - nu ** 2) / E * c, rel=1e-14)
+    assert sneddon.opening_displacement(0.2, P, E, nu, c) == 0.0
+    # the crack volume of the ellipse: ∫ 2u_y dx = π c² · 2P(1 − ν²)/E
+    x = np.linspace(-c, c, 200001)
+    vol = np.trapz(2 * sneddon.opening_displacement(x, P, E, nu, c), x)
+    assert vol == pytest.approx(math.pi * c * c * 2 * P * (1 - nu ** 2) / E, rel=1e-5)
+    # Eq. 44: far field → 0, near tip ≈ K_I/√(2πr) − P
+    assert sneddon.stress_ahead(100.0, P, c) == pytest.approx(P * c * c / (2 * 100.0 ** 2), rel=1e-3)
+    r = 1e-6
+    assert sneddon.stress_ahead(c + r, P, c) == pytest.approx(sneddon.stress_intensity(P, c) / math.sqrt(2 * math.pi * r) - P, rel=1e-4)
+    assert np.isnan(sneddon.stress_ahead(0.1, P, c))
+    with pytest.raises(ValueError, match="pressurised half-length"):
+        sneddon.opening_displacement(0.0, P, E, nu, c, a=0.3)
+
+
+def test_elastic_opening_and_tip_stress_small_block(tmp_path):
+    """2.5 m block, l = 0.04 m (15.6 k particles): the finite block opens the crack a little more than
+    the infinite medium of Sneddon's solution."""
+    s = penny_crack.main(["--out", str(tmp_path), "--parts", "elastic", "--size", "2.5", "--spacing", "0.04",
+                          "--progress", "1000"])
+    assert abs(s["uy_center_rel_error"]) < 0.10
+    assert s["uy_l2_rel_error"] < 0.15
+    d = np.loadtxt(tmp_path / "elastic_stress_ahead.csv", delimiter=",", skiprows=1)
+    near = d[0]                                  # first particle ahead of the tip
+    assert near[0] == pytest.approx(0.21, abs=1e-9)
+    assert near[1] == pytest.approx(near[3], rel=0.15)   # σyy vs Eq. 44 at 0.5 particle spacing from the tip
+    mid = (d[:, 0] > 0.28) & (d[:, 0] < 0.7)
+    assert np.all(np.diff(d[mid, 1]) < 0)      # decays away from the tip
+    assert np.sqrt(np.sum((d[mid, 1] - d[mid, 3]) ** 2) / np.sum(d[mid, 3] ** 2)) < 0.35
+    for f in ("elastic_uy.csv", "elastic_profiles.png", "summary.json"):
+        assert (tmp_path / f).exists()
+
+
+def test_damage_grows_symmetrically_and_monotonically(tmp_path):
+    """1.2 m block at the paper's l = 0.02 m (14 k particles), P = 75 MPa ramped over 4 ms."""
+    s = penny_crack.main(["--out", str(tmp_path), "--parts", "damage", "--size", "1.2", "--ramp-time", "0.004",
+                          "--end-time", "0.2", "--record-every", "0.005", "--laws", "0", "--progress", "1000"])
+    rows = np.loadtxt(tmp_path / "crack_extension_law0.csv", delimiter=",", skiprows=1)
+    left, right = rows[:, 2], rows[:, 3]
+    assert np.all(np.abs(left - right) <= 1)
+    assert np.all(np.diff(left) >= 0) and np.all(np.diff(right) >= 0)
+    assert right[-1] >= 10                       # grows well beyond the initial tip
+    assert rows[0, 2] == 0                       # no crack before the load
+    # rock ahead of the crack does not yield: every particle with plastic strain is a tensile crack
+    assert s["plastic_particles_not_cracked"] == 0
+    summ = json.loads((tmp_path / "summary.json").read_text())
+    assert summ["crack_extension_cells"][0]["t_s"] == 0.05
