@@ -175,6 +175,33 @@ def case_mass_contrast(fast):
     return s, dict(end_time=40 * 0.5 / s.waveSpeed())
 
 
+def case_edge_deforming(fast):
+    """Rock block filling the grid to its edges (margin 0, no side walls), gravity and a 20 MPa top
+    compression ramped over 2 transits: the outer particles deform in cells whose stencils reach past the
+    grid, where the WLS fit uses the reduced node set (Eqs. 10, 15 with M assembled from active nodes)."""
+    mat = ym.ElasticMat(**ROCK)
+    s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), margin=0)
+    s.gravity = (0.0, -9.81)
+    tt = transit_time(mat, 1.0)
+    top_traction(s, h, 2, -20e6, 2 * tt)
+    return s, dict(end_time=30 * tt)
+
+
+def case_mass_stacked(fast):
+    """Heavy (1e7 kg/m³) half resting on a light (1 kg/m³) half, same E = 100 MPa, fixed floor, gravity:
+    the light layer is loaded by a weight 1e7× its own (run for 100 light transits)."""
+    mat = ym.ElasticMat(young=1e8, poisson=0.25, density=1.0)
+    h = 0.5 / (cells_per_m(fast) // 2)
+    s = ym.make_solver((0.0, 0.0), (0.5, 1.0), h, margin=2)
+    ym.add_region(s, mat, (0.0, 0.0), (0.5, 1.0), ppc=2)
+    s.view("mass")[s.view("x1") > 0.5] *= 1e7
+    s.requestSort()
+    s.addBoundaryPlane(1, -1, 0.0, "fixed")
+    s.gravity = (0.0, -9.81)
+    s.stableDt()
+    return s, dict(end_time=100 * 0.5 / s.waveSpeed())
+
+
 CASES = {
     "stiff_E200GPa": (case_stiff, "elastic block E = 200 GPa, gravity + 50 MPa top compression (quasi-static ramp)"),
     "incompressible_nu049": (case_incompressible, "elastic block ν = 0.49 on a slip floor, 10 MPa top compression"),
@@ -184,7 +211,9 @@ CASES = {
     "column_collapse": (case_column_collapse, "DP column (c = 100 Pa, φ = 30°) collapsing under gravity"),
     "fully_damaged": (case_damaged, "DP–GK rock, D = 1 band, upper half launched up at 10 m/s"),
     "grid_edge": (case_grid_edge, "block at 100 m/s towards the grid edge, no walls"),
+    "edge_deforming": (case_edge_deforming, "rock block filling the grid to its edges, 20 MPa fast compression"),
     "mass_contrast": (case_mass_contrast, "densities 1 and 1e7 kg/m³ side by side under gravity"),
+    "mass_stacked": (case_mass_stacked, "1e7 kg/m³ half resting on a 1 kg/m³ half under gravity"),
 }
 
 
