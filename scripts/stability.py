@@ -115,6 +115,18 @@ def case_rate_100x(fast):
     return rock_rate(fast, 100.0)
 
 
+def case_overload(fast):
+    """DP–GK rock hit by a 200 MPa top compression applied at once (no ramp), ≈ 2.2× the rock's
+    Mohr–Coulomb uniaxial strength 2c·cosφ/(1 − sinφ) ≈ 90 MPa: the block is crushed, a loaded top corner
+    particle is squeezed out sideways and leaves the grid (2 margin cells on the left), which must stop the
+    run with the grid-edge message."""
+    mat = ym.DpGkMat(**ROCK_DPGK)
+    s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), extra_x=0.5, extra_y=0.5)
+    s.gravity = (0.0, -9.81)
+    top_traction(s, h, 2, -200e6, 0.0)
+    return s, dict(end_time=20 * transit_time(mat, 1.0), expect="stopped_with_error")
+
+
 def case_column_collapse(fast):
     """Weak frictional column (DP, φ = 30°, c = 100 Pa, no damage) 0.2 m × 0.4 m against a slip wall,
     collapsing under gravity onto a fixed (no-slip) floor; runs until it has spread out."""
@@ -209,6 +221,7 @@ CASES = {
     "soft_E1MPa": (case_soft, "elastic block E = 1 MPa, gravity + 50 kPa top compression"),
     "rate_baseline": (case_rate_baseline, "DP–GK rock, 20 MPa top compression ramped over 20 P-wave transits"),
     "rate_100x": (case_rate_100x, "same, ramp 100× faster (0.2 transits): a stress wave"),
+    "overload_step": (case_overload, "DP–GK rock, 200 MPa top compression applied at once: crushed"),
     "column_collapse": (case_column_collapse, "DP column (c = 100 Pa, φ = 30°) collapsing under gravity"),
     "fully_damaged": (case_damaged, "DP–GK rock, D = 1 band, upper half launched up at 10 m/s"),
     "grid_edge": (case_grid_edge, "block at 100 m/s towards the grid edge, no walls"),
