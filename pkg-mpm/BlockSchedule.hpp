@@ -58,6 +58,16 @@ struct BlockSchedule {
 		return true;
 	}
 
+	// The same test as bounds on the fractional cell coordinate (x − origin)/l, per axis.
+	void reach(size_t b, Real* lo, Real* hi) const
+	{
+		IVec bc = blockCoords(b);
+		for (int a = 0; a < D; ++a) {
+			lo[a] = bc[a] * B - margin;
+			hi[a] = (bc[a] + 1) * B + margin;
+		}
+	}
+
 	// Stable counting sort of the particles by block; permutes every particle field.
 	void sort(const Grid<D>& g, Particles<D>& P)
 	{

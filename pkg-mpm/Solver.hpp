@@ -313,26 +313,30 @@ private:
 		        "MPM stopped at step " + std::to_string(steps) + " (t = " + fmt(time) + " s) in " + phaseName + ": particle id " + std::to_string(P.id[e.particle])
 		        + " " + e.what);
 	}
-	bool stencilOf(size_t p, Stencil<D>& st) const
+	void kernelOf(size_t p, Kernel<D>& k) const
 	{
 		Real x[D];
 		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
-		return computeStencil(grid, offs, x, st);
+		computeKernel(grid, offs, x, k);
 	}
 	Real dxOf(const Stencil<D>& st, int n, int a) const { return st.d[a][Stencil<D>::along(n, a)]; }
 
 	// ---------------------------------------------------------------- P2G: Eqs. 20–22
+	// Every node receives w·(P0 + Σ_b A_b (x_i − x_p)_b) with the per-particle affine coefficients
+	// P0 = [m, m, m v, f_ext] and A_b = [0, 0, m C_·b, −V σ_·b 3/l²] (interior particles, where
+	// ∇ψ_i = w_i 3/l² (x_i − x_p)); particles with a general WLS stencil go through the full ψ, ∇ψ.
 	template <class Mat>
 	void p2g(const Mat& mat)
 	{
 		auto& nodes = grid.nodes;
 #pragma omp parallel for schedule(static)
-		for (size_t i = 0; i < nodes.size(); ++i) nodes[i] = Node<D> {};
+		for (size_t i = 0; i < nodes.size(); ++i) lanes(nodes[i]) = NodeLanes {}; // padding lanes too
 		const Real  s = loadScale(time);
+		const Real  Dinv = 3.0 / (grid.spacing * grid.spacing); // interior M⁻¹ gradient factor
 		ErrorRecord err;
 		scatterPass([&](size_t p) {
-			Stencil<D> st;
-			if (!stencilOf(p, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			Kernel<D> k;
+			kernelOf(p, k);
 			const Real   m = P.mass[p], V = P.vol[p];
 			const Sym<D> sg = mat.forceStress(P, p);
 			Real         mv[D], mC[D][D], fe[D];
@@ -341,6 +345,34 @@ private:
 				for (int b = 0; b < D; ++b) mC[a][b] = m * P.C[a * D + b][p];
 				fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
 			}
+			if (!k.general) {
+				Real sgm[D][D];
+				sym2full(sg, sgm);
+				// lanes: m, mw, momentum…, force…
+				const NodeLanes P0 = nodeLanes(m, m, mv, fe);
+				NodeLanes       A[D];
+				for (int b = 0; b < D; ++b) {
+					Real ca[D], fa[D];
+					for (int a = 0; a < D; ++a) {
+						ca[a] = mC[a][b];
+						fa[a] = -V * Dinv * sgm[a][b]; // Eq. 21, f_int = −Σ V σ ∇ψ
+					}
+					A[b] = nodeLanes(0, 0, ca, fa);
+				}
+				forRows(k, [&](size_t row, Real wr, const Real* dr) {
+					NodeLanes R = P0;
+					for (int b = 1; b < D; ++b) R += A[b] * dr[b - 1];
+					R *= wr;
+					const NodeLanes S = A[0] * wr;
+					for (int i = 0; i < 4; ++i) { // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
+						const Real wx = k.w[0][i];
+						lanes(nodes[row + i]) += wx * R + (wx * k.d[0][i]) * S;
+					}
+				});
+				return;
+			}
+			Stencil<D> st;
+			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 			for (int n = 0; n < N; ++n) {
 				Node<D>&    nd  = nodes[st.base + offs.off[n]];
 				const Real  psi = st.psi[n];
@@ -358,6 +390,38 @@ private:
 			}
 		});
 		throwIf(err, "P2G");
+	}
+	// Lane vector of a node: m, mw, a…, b… (and zero padding in 2D).
+	static NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
+	{
+		if constexpr (D == 2) return NodeLanes { m, mw, a[0], a[1], b[0], b[1], 0, 0 };
+		else return NodeLanes { m, mw, a[0], a[1], a[2], b[0], b[1], b[2] };
+	}
+	static void sym2full(const Sym<D>& s, Real (&f)[D][D])
+	{
+		f[0][0] = s.c[0], f[1][1] = s.c[1], f[0][1] = f[1][0] = s.c[3];
+		if constexpr (D == 3) {
+			f[2][2] = s.c[2];
+			f[0][2] = f[2][0] = s.c[4];
+			f[1][2] = f[2][1] = s.c[5];
+		}
+	}
+	// Visits the 4^(D−1) stencil rows along x of an interior kernel: f(linear index of the row's first
+	// node, product of the row's weights along y[, z], its offsets (x_i − x_p) along y[, z]).
+	template <class F>
+	void forRows(const Kernel<D>& k, F&& f) const
+	{
+		const size_t sy = grid.stride[1];
+		if constexpr (D == 2) {
+			for (int j = 0; j < 4; ++j) f(k.base + j * sy, k.w[1][j], &k.d[1][j]);
+		} else {
+			const size_t sz = grid.stride[2];
+			for (int l = 0; l < 4; ++l)
+				for (int j = 0; j < 4; ++j) {
+					const Real dr[2] = { k.d[1][j], k.d[2][l] };
+					f(k.base + l * sz + j * sy, k.w[1][j] * k.w[2][l], dr);
+				}
+		}
 	}
 	static void stressTimesVector(const Sym<D>& s, const Real* g, Real* out)
 	{
@@ -400,11 +464,41 @@ private:
 	void g2p()
 	{
 		auto&       nodes = grid.nodes;
+		const Real  Dinv  = 3.0 / (grid.spacing * grid.spacing);
 		ErrorRecord err;
 		scatterPass([&](size_t p) {
+			Kernel<D> k;
+			kernelOf(p, k);
+			const Real m = P.mass[p];
+			Real       v[D] = {}, C[D][D] = {};
+			if (!k.general) {
+				gatherInterior<2>(k, v, C); // Eqs. 6–7 from the updated velocities (lanes a)
+				storeVelocity(p, v, C);
+				NodeLanes H[D + 1]; // m h_p(x_i) = m (v + ∇v (x_i − x_p)) into lanes b
+				{
+					const Real zero[D] = {};
+					Real       mvv[D], mc[D];
+					for (int a = 0; a < D; ++a) mvv[a] = m * v[a];
+					H[D] = nodeLanes(0, 0, zero, mvv);
+					for (int b = 0; b < D; ++b) {
+						for (int a = 0; a < D; ++a) mc[a] = m * C[a][b];
+						H[b] = nodeLanes(0, 0, zero, mc);
+					}
+				}
+				forRows(k, [&](size_t row, Real wr, const Real* dr) { // Eq. 16 numerator, Σ w m h_p(x_i)
+					NodeLanes R = H[D];
+					for (int b = 1; b < D; ++b) R += H[b] * dr[b - 1];
+					R *= wr;
+					const NodeLanes S = H[0] * wr;
+					for (int i = 0; i < 4; ++i) {
+						const Real wx = k.w[0][i];
+						lanes(nodes[row + i]) += wx * R + (wx * k.d[0][i]) * S;
+					}
+				});
+				return;
+			}
 			Stencil<D> st;
-			if (!stencilOf(p, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
-			Real v[D] = {}, C[D][D] = {};
+			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 			for (int n = 0; n < N; ++n) {
 				const Node<D>& nd = nodes[st.base + offs.off[n]];
 				for (int a = 0; a < D; ++a) {
@@ -412,11 +506,7 @@ private:
 					for (int b = 0; b < D; ++b) C[a][b] += nd.a[a] * st.grad[n][b]; // Eq. 7
 				}
 			}
-			const Real m = P.mass[p];
-			for (int a = 0; a < D; ++a) {
-				P.v[a][p] = v[a];
-				for (int b = 0; b < D; ++b) P.C[a * D + b][p] = C[a][b];
-			}
+			storeVelocity(p, v, C);
 			for (int n = 0; n < N; ++n) {
 				Node<D>&   nd = nodes[st.base + offs.off[n]];
 				const Real wm = st.w[n] * m;
@@ -428,6 +518,38 @@ private:
 			}
 		});
 		throwIf(err, "G2P");
+	}
+	// Interior gather of a nodal vector field u (lanes first..first+D−1): u_p = Σ w_i u_i and
+	// ∇u_p = Σ u_i ⊗ ∇ψ_i with ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7).
+	template <int first>
+	void gatherInterior(const Kernel<D>& k, Real (&u)[D], Real (&G)[D][D]) const
+	{
+		const auto& nodes = grid.nodes;
+		NodeLanes   U = {}, Gb[D] = {};
+		forRows(k, [&](size_t row, Real wr, const Real* dr) {
+			NodeLanes r0 = {}, r1 = {};
+			for (int i = 0; i < 4; ++i) {
+				const NodeLanes& q  = lanes(nodes[row + i]);
+				const Real       wx = k.w[0][i];
+				r0 += wx * q;
+				r1 += (wx * k.d[0][i]) * q;
+			}
+			U += wr * r0;
+			Gb[0] += wr * r1;
+			for (int b = 1; b < D; ++b) Gb[b] += (wr * dr[b - 1]) * r0;
+		});
+		const Real Dinv = 3.0 / (grid.spacing * grid.spacing);
+		for (int a = 0; a < D; ++a) {
+			u[a] = U[first + a];
+			for (int b = 0; b < D; ++b) G[a][b] = Dinv * Gb[b][first + a];
+		}
+	}
+	void storeVelocity(size_t p, const Real (&v)[D], const Real (&C)[D][D])
+	{
+		for (int a = 0; a < D; ++a) {
+			P.v[a][p] = v[a];
+			for (int b = 0; b < D; ++b) P.C[a * D + b][p] = C[a][b];
+		}
 	}
 	void gridMusl()
 	{
@@ -446,27 +568,23 @@ private:
 	template <class Mat>
 	void updateStress(const Mat& mat, Real dt)
 	{
-		const auto& nodes = grid.nodes;
 		ErrorRecord err;
-		Real        vm = 0, rmin = INFINITY;
+		Real        v2max = 0, rmin = INFINITY;
 		bool        drift = false;
 		const auto& blocks = sched.start;
 		const long  nb     = long(blocks.size()) - 1;
 		const Vec   lo = grid.origin, hi = grid.upper();
-#pragma omp parallel for schedule(dynamic, 4) reduction(max : vm) reduction(min : rmin) reduction(|| : drift)
+		const Real  invH = 1.0 / grid.spacing;
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : v2max) reduction(min : rmin) reduction(|| : drift)
 		for (long b = 0; b < nb; ++b) {
+			Real cellLo[D], cellHi[D]; // cells a particle of block b may reach before a re-sort
+			sched.reach(size_t(b), cellLo, cellHi);
 			for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
 				const size_t p = pp;
-				Stencil<D>   st;
-				if (!stencilOf(p, st)) {
+				Real L[D][D] = {}; // ∇v from the MUSL nodal velocities, Eq. 7
+				if (!velocityGradient(p, L)) {
 					err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 					continue;
-				}
-				Real L[D][D] = {}; // ∇v from the MUSL nodal velocities, Eq. 7
-				for (int n = 0; n < N; ++n) {
-					const Node<D>& nd = nodes[st.base + offs.off[n]];
-					for (int a = 0; a < D; ++a)
-						for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];
 				}
 				Sym<D> de;   // Δε = sym(∇v) Δt, Eq. 29
 				Sym<D> s = P.stress(p);
@@ -476,34 +594,61 @@ private:
 				P.setStress(p, s);
 				const Real J = jacobian(L, dt);
 				P.vol[p] *= J;
-				Real sp = 0;
-				int  cell[D];
-				bool finite = s.finite() && J > 0 && std::isfinite(J);
+				Real sp = 0, check = J;
+				bool inside = true, near = true;
+				for (int k = 0; k < Dim<D>::nSym; ++k) check += s.c[k];
 				for (int a = 0; a < D; ++a) {
-					P.x[a][p] += dt * P.v[a][p];
-					sp += P.v[a][p] * P.v[a][p];
-					finite = finite && std::isfinite(P.x[a][p]) && std::isfinite(P.v[a][p]);
-					cell[a] = int(std::floor((P.x[a][p] - lo[a]) / grid.spacing));
+					const Real va = P.v[a][p], xa = P.x[a][p] + dt * va;
+					P.x[a][p] = xa;
+					sp += va * va;
+					check += xa;
+					inside = inside && xa >= lo[a] && xa < hi[a];
+					const Real f = (xa - lo[a]) * invH;
+					near = near && f >= cellLo[a] && f < cellHi[a];
 				}
-				if (!finite) {
+				// one sum carries every value that must be finite (NaN/inf propagate), checked once
+				if (!(std::isfinite(check) && std::isfinite(sp) && J > 0)) {
 					err.record(p, describeBad(p, s, J));
 					continue;
 				}
-				for (int a = 0; a < D; ++a)
-					if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
-						err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmt(P.x[a][p]) + " m (grid spans [" + fmt(lo[a]) + ", "
-						                      + fmt(hi[a]) + ") m)");
-						break;
-					}
-				vm   = std::max(vm, std::sqrt(sp));
-				rmin = std::min(rmin, P.mass[p] / P.vol[p]);
-				if (!sched.within(size_t(b), cell)) drift = true;
+				if (!inside) {
+					for (int a = 0; a < D; ++a)
+						if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
+							err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmt(P.x[a][p]) + " m (grid spans [" + fmt(lo[a])
+							                      + ", " + fmt(hi[a]) + ") m)");
+							break;
+						}
+					continue;
+				}
+				v2max = std::max(v2max, sp);
+				rmin  = std::min(rmin, P.mass[p] / P.vol[p]);
+				drift = drift || !near;
 			}
 		}
 		throwIf(err, "stress update");
-		vmax   = vm;
+		vmax   = std::sqrt(v2max);
 		rhoMin = rmin;
 		if (drift) needSort = true;
+	}
+	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (Eq. 7). False if the WLS fit is singular.
+	bool velocityGradient(size_t p, Real (&L)[D][D]) const
+	{
+		const auto& nodes = grid.nodes;
+		Kernel<D>   k;
+		kernelOf(p, k);
+		if (!k.general) {
+			Real v[D];
+			gatherInterior<2 + D>(k, v, L); // MUSL velocities (lanes b)
+			return true;
+		}
+		Stencil<D> st;
+		if (!fillStencil(grid, offs, k, st)) return false;
+		for (int n = 0; n < N; ++n) {
+			const Node<D>& nd = nodes[st.base + offs.off[n]];
+			for (int a = 0; a < D; ++a)
+				for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];
+		}
+		return true;
 	}
 	std::string describeBad(size_t p, const Sym<D>& s, Real J) const
 	{

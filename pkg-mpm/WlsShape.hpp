@@ -51,41 +51,63 @@ struct StencilOffsets {
 	StencilOffsets() = default;
 };
 
-// Fills st for a particle at x. Returns false when the active nodes cannot support a linear fit
-// (singular moment matrix). The caller has checked that x lies inside the physical grid.
+// Per-particle, per-step tensor-product data: the 4 one-dimensional B-spline weights and node offsets
+// x_i − x_p along each axis. For an interior particle (all 4^D nodes active) this is all a transfer needs,
+// because there ψ_i = w_i = Π_a w1[a][i_a] and ∇ψ_i = w_i·3/l²·(x_i − x_p): the kernels expand the
+// products row by row instead of storing 4^D values. `general` marks particles that need the full
+// WLS stencil (reduced node set, Eqs. 10–15).
 template <int D>
-inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Stencil<D>& st)
+struct Kernel {
+	size_t base;    // linear index of stencil node (0,0[,0])
+	Real   w[D][4]; // one-dimensional cubic B-spline weights, Eq. 13
+	Real   d[D][4]; // x_i − x_p per axis for the 4 stencil layers [m]
+	bool   general; // some stencil node is a ghost or excluded: use computeStencil
+};
+
+template <int D>
+inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Kernel<D>& k)
 {
-	constexpr int N = Dim<D>::nStencil;
-	const Real    h = g.spacing, invH = 1.0 / g.spacing;
-	Real          w1[D][4];
-	int           cell[D];
-	bool          nearEdge = false;
-	size_t        base     = 0;
+	const Real h = g.spacing, invH = 1.0 / g.spacing;
+	bool       nearEdge = false;
+	size_t     base     = 0;
 	for (int a = 0; a < D; ++a) {
 		Real f  = (x[a] - g.origin[a]) * invH;
 		int  c  = int(std::floor(f));
-		cell[a] = c;
 		Real t  = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
 		Real u  = 1 - t;
-		w1[a][0] = u * u * u / 6.0;
-		w1[a][1] = 0.5 * t * t * t - t * t + 2.0 / 3.0;
-		w1[a][2] = 0.5 * u * u * u - u * u + 2.0 / 3.0;
-		w1[a][3] = t * t * t / 6.0;
-		for (int k = 0; k < 4; ++k) st.d[a][k] = (k - 1 - t) * h;
+		k.w[a][0] = u * u * u * (1.0 / 6.0);
+		k.w[a][1] = 0.5 * t * t * t - t * t + 2.0 / 3.0;
+		k.w[a][2] = 0.5 * u * u * u - u * u + 2.0 / 3.0;
+		k.w[a][3] = t * t * t * (1.0 / 6.0);
+		for (int j = 0; j < 4; ++j) k.d[a][j] = (j - 1 - t) * h;
 		if (c - 1 < 0 || c + 2 > g.cells[a]) nearEdge = true;
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
-	st.base = base;
-	for (int n = 0; n < N; ++n) {
-		Real w = 1;
-		for (int a = 0; a < D; ++a) w *= w1[a][Stencil<D>::along(n, a)];
-		st.w[n] = w;
-	}
+	k.base  = base;
 	bool general = nearEdge;
 	if (!general && g.userExclusions())
-		for (int n = 0; n < N && !general; ++n) general = g.excluded[base + so.off[n]];
-	st.general = general;
+		for (int n = 0; n < Dim<D>::nStencil && !general; ++n) general = g.excluded[base + so.off[n]];
+	k.general = general;
+}
+
+// Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit
+// (singular moment matrix).
+template <int D>
+inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Kernel<D>& k, Stencil<D>& st)
+{
+	constexpr int N = Dim<D>::nStencil;
+	const Real    invH = 1.0 / g.spacing;
+	const size_t  base = k.base;
+	st.base            = base;
+	for (int a = 0; a < D; ++a)
+		for (int j = 0; j < 4; ++j) st.d[a][j] = k.d[a][j];
+	for (int n = 0; n < N; ++n) {
+		Real w = 1;
+		for (int a = 0; a < D; ++a) w *= k.w[a][Stencil<D>::along(n, a)];
+		st.w[n] = w;
+	}
+	const bool general = k.general;
+	st.general         = general;
 
 	if (!general) { // interior closed form: M⁻¹ = diag(1, 3/l², …)
 		const Real s = 3.0 * invH * invH;
@@ -122,8 +144,16 @@ inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const 
 		st.psi[n] = st.w[n] * q[0];
 		for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
 	}
-	(void)cell;
 	return true;
+}
+
+// Fills st for a particle at x (the caller has checked that x lies inside the physical grid).
+template <int D>
+inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Stencil<D>& st)
+{
+	Kernel<D> k;
+	computeKernel(g, so, x, k);
+	return fillStencil(g, so, k, st);
 }
 
 } // namespace mpm

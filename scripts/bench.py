@@ -1,0 +1,250 @@
+#!/usr/bin/python3
+"""Performance benchmark of the MPM core (issue 4).
+
+Fixed scenes, nothing printed or written while the timed steps run. For every case it reports
+particle-steps per second (particles × steps / wall seconds of the stepping only), ns per
+particle-step, the wall time per phase (sort, P2G, grid update, contact, G2P + MUSL remap, stress
+update), the particle storage in bytes per particle and the peak-RSS growth per particle. Every case
+runs in a fresh subprocess (clean peak RSS, thread count fixed before OpenMP starts) and is repeated;
+the median is reported (2 threads on a shared host are noisy).
+
+Cases: 2D elastic 80 k and 1 M particles, 2D DP–GK 80 k (loaded so that a good share yields and
+some particles damage), 3D elastic 500 k; each with 1 and 2 threads; and the 2D DP–GK 80 k scene
+through YADE's O.run (MpmEngine hook) versus direct stepping, for the hook overhead.
+
+    /usr/bin/python3 scripts/bench.py --out results/bench            # full matrix (~10 min)
+    /usr/bin/python3 scripts/bench.py --out /tmp/b --quick           # fewer steps/repeats, no 1 M / 3D
+    /usr/bin/python3 scripts/bench.py --out /tmp/b --cases dpgk2d_80k --threads 2
+
+Writes DIR/summary.json ({cases: [{case, dim, material, contact, particles, threads,
+particle_steps_per_s, ns_per_particle_step, phases, bytes_per_particle, ...}], hook: {...}}) and
+DIR/table.md (the table in doc/performance.md)."""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+# name: (dim, material, cells per axis of the particle block, timed steps, warm-up steps)
+CASES = {
+    "elastic2d_80k": (2, "elastic", (200, 100), 300, 20),
+    "elastic2d_1m": (2, "elastic", (500, 500), 40, 5),
+    "dpgk2d_80k": (2, "dpgk", (200, 100), 300, 20),
+    "elastic3d_500k": (3, "elastic", (50, 50, 25), 30, 3),
+}
+QUICK_STEPS = {"elastic2d_80k": 100, "elastic2d_1m": 15, "dpgk2d_80k": 100, "elastic3d_500k": 10}
+
+SPACING = 0.01  # grid spacing l [m]; 2 particles per cell per axis
+ROCK = dict(young=22.41e9, poisson=0.2313, density=2500)  # the paper's granite-like rock
+
+
+def build_scene(dim, material, cells):
+    """The benchmark block: rock on a fixed floor with slip side walls, deformed by an initial
+    pure-shear velocity field v = ε̇ (x − x_c) along x and −ε̇ (y − y_c) along y, so the stress grows
+    to the DP–GK yield and damage thresholds within the warm-up. Returns the solver."""
+    import math
+    import numpy as np
+    import yade_mpm as ym
+    size = [c * SPACING for c in cells]
+    lo, hi = (0.0,) * dim, tuple(size)
+    s = ym.make_solver(lo, hi, SPACING, margin=3)
+    if material == "elastic":
+        mat = ym.ElasticMat(**ROCK)
+    else:
+        # Cohesion and Weibull parameters chosen so that, at this strain rate, about half of the
+        # particles are plastic and a part of them damages during the timed steps.
+        mat = ym.DpGkMat(**ROCK, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
+                         critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
+    ym.add_region(s, mat, lo, hi, ppc=2)
+    s.addBoundaryPlane(1, -1, 0.0, "fixed")
+    s.addBoundaryPlane(0, -1, 0.0, "slip")
+    s.addBoundaryPlane(0, +1, size[0], "slip")
+    s.gravity = (0.0, -9.81) if dim == 2 else (0.0, -9.81, 0.0)
+    rate = 40.0  # ε̇ [1/s]
+    x0, x1 = s.view("x0"), s.view("x1")
+    s.view("v0")[:] = rate * (x0 - 0.5 * size[0])
+    s.view("v1")[:] = -rate * x1
+    return s
+
+
+def peak_rss_bytes():
+    import resource
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def run_direct(name, steps, warmup):
+    """Child process: build, warm up, time `steps` solver steps."""
+    import yade_mpm as ym
+    dim, material, cells, _, _ = CASES[name]
+    rss0 = peak_rss_bytes()
+    s = build_scene(dim, material, cells)
+    s.run(warmup)
+    s.resetPhaseTimes()
+    t0 = time.perf_counter()
+    s.run(steps)
+    wall = time.perf_counter() - t0
+    out = dict(steps=steps, wall=wall, phases=s.phaseTimes(), particles=s.numParticles,
+               bytes_per_particle=s.bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
+               threads=ym.getThreads())
+    out.update(material_stats(s))
+    return out
+
+
+def material_stats(s):
+    """Share of particles that are plastic / damaged at the end (DP–GK), to show the scene is loaded."""
+    import numpy as np
+    try:
+        eps, dmg = s.view("epsP"), s.view("damage")
+    except ValueError:
+        return {}
+    return dict(plastic_fraction=float(np.mean(eps > 0)), damaged_fraction=float(np.mean(dmg > 0)))
+
+
+def run_yade(name, steps, warmup):
+    """Child process: the same scene through YADE's loop (O.run with the MpmEngine PyRunner)."""
+    import yade_mpm as ym
+    from yade import O
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+    dim, material, cells, _, _ = CASES[name]
+    s = build_scene(dim, material, cells)
+    e = ym.MpmEngine(s, label="mpmbench")
+    O.engines = [ForceResetter(), e.runner(), NewtonIntegrator()]
+    O.dt = 1.0
+    O.run(warmup, True)
+    s.resetPhaseTimes()
+    t0 = time.perf_counter()
+    O.run(steps, True)
+    wall = time.perf_counter() - t0
+    return dict(steps=steps, wall=wall, phases=s.phaseTimes(), particles=s.numParticles, threads=ym.getThreads())
+
+
+def child(args):
+    fn = run_yade if args.mode == "yade" else run_direct
+    res = fn(args.case, args.steps, args.warmup)
+    print("BENCH " + json.dumps(res), flush=True)
+
+
+def spawn(case, mode, threads, steps, warmup):
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", "--mode", mode, "--case", case, "--steps", str(steps),
+           "--warmup", str(warmup)]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    line = [l for l in r.stdout.splitlines() if l.startswith("BENCH ")]
+    if r.returncode != 0 or not line:
+        raise RuntimeError(f"benchmark child {case}/{mode}/{threads}T failed:\n{r.stdout[-2000:]}\n{r.stderr[-2000:]}")
+    return json.loads(line[0][6:])
+
+
+def summarise(case, runs):
+    """Median over repeats of the steps/s; phases as fractions from the median run."""
+    dim, material, _, _, _ = CASES[case]
+    rates = [r["particles"] * r["steps"] / r["wall"] for r in runs]
+    med = statistics.median(rates)
+    rep = min(runs, key=lambda r: abs(r["particles"] * r["steps"] / r["wall"] - med))
+    n, st = rep["particles"], rep["steps"]
+    phases = {k: v / (n * st) * 1e9 for k, v in rep["phases"].items()}  # ns per particle-step
+    row = dict(case=case, dim=dim, material=material, contact=False, particles=n, threads=rep["threads"],
+               particle_steps_per_s=med, ns_per_particle_step=1e9 / med,
+               rate_min=min(rates), rate_max=max(rates), repeats=len(runs),
+               phases=phases, bytes_per_particle=rep["bytes_per_particle"],
+               peak_rss_bytes_per_particle=rep["rss_per_particle"])
+    for k in ("plastic_fraction", "damaged_fraction"):
+        if k in rep:
+            row[k] = rep[k]
+    return row
+
+
+def table(rows, hook):
+    out = ["| case | particles | threads | M p-steps/s (median; min–max) | ns/p-step | sort / P2G / grid / G2P+MUSL / stress [ns/p-step] | bytes/particle (storage; peak RSS) |",
+           "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ph = r["phases"]
+        out.append(f"| {r['case']} | {r['particles']:,} | {r['threads']} | **{r['particle_steps_per_s'] / 1e6:.2f}** "
+                   f"({r['rate_min'] / 1e6:.2f}–{r['rate_max'] / 1e6:.2f}) | {r['ns_per_particle_step']:.0f} | "
+                   f"{ph['sort']:.1f} / {ph['p2g']:.1f} / {ph['grid']:.1f} / {ph['g2p']:.1f} / {ph['stress']:.1f} | "
+                   f"{r['bytes_per_particle']}; {r['peak_rss_bytes_per_particle']:.0f} |")
+    by = {(r["case"], r["threads"]): r for r in rows}
+    out.append("")
+    for c in CASES:
+        if (c, 1) in by and (c, 2) in by:
+            out.append(f"- {c}: 2 threads / 1 thread = {by[(c, 2)]['particle_steps_per_s'] / by[(c, 1)]['particle_steps_per_s']:.2f}")
+    if hook:
+        out.append(f"- YADE hook ({hook['case']}, {hook['threads']} threads): O.run {hook['yade_rate'] / 1e6:.2f} M p-steps/s vs direct "
+                   f"{hook['direct_rate'] / 1e6:.2f} M → overhead {100 * hook['overhead']:.1f} % (median of paired runs)")
+    return "\n".join(out)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", help="output directory (summary.json, table.md)")
+    ap.add_argument("--cases", default=",".join(CASES), help="comma-separated subset of " + ",".join(CASES))
+    ap.add_argument("--threads", default="1,2", help="thread counts, e.g. 1,2")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (smoke test)")
+    ap.add_argument("--no-hook", action="store_true", help="skip the YADE O.run comparison")
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--mode", default="direct", help=argparse.SUPPRESS)
+    ap.add_argument("--case", help=argparse.SUPPRESS)
+    ap.add_argument("--steps", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--warmup", type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        return child(args)
+    if not args.out:
+        raise SystemExit("--out DIR is required")
+    cases = [c for c in args.cases.split(",") if c]
+    for c in cases:
+        if c not in CASES:
+            raise SystemExit(f"unknown case '{c}'; known: {', '.join(CASES)}")
+    threads = [int(t) for t in args.threads.split(",")]
+    if any(t < 1 for t in threads):
+        raise SystemExit("--threads must be positive integers")
+    if args.repeats < 1:
+        raise SystemExit("--repeats must be >= 1")
+    repeats = 1 if args.quick else args.repeats
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    jobs = [(c, t) for c in cases for t in threads]
+    t_start = time.time()
+    for k, (c, t) in enumerate(jobs):
+        _, _, _, steps, warm = CASES[c]
+        if args.quick:
+            steps, warm = QUICK_STEPS[c], min(warm, 5)
+        runs = [spawn(c, "direct", t, steps, warm) for _ in range(repeats)]
+        rows.append(summarise(c, runs))
+        r = rows[-1]
+        print(f"[bench {k + 1}/{len(jobs)}, {time.time() - t_start:.0f} s] {c} {t}T: {r['particle_steps_per_s'] / 1e6:.2f} M p-steps/s, "
+              f"{r['ns_per_particle_step']:.0f} ns/p-step", flush=True)
+    hook = None
+    if not args.no_hook:
+        c = "dpgk2d_80k" if "dpgk2d_80k" in cases else cases[0]
+        t = max(threads)
+        _, _, _, steps, warm = CASES[c]
+        if args.quick:
+            steps, warm = QUICK_STEPS[c], 5
+        ratios, yr, dr = [], [], []
+        for _ in range(repeats):  # paired runs, alternating, so host noise hits both alike
+            d = spawn(c, "direct", t, steps, warm)
+            y = spawn(c, "yade", t, steps, warm)
+            dr.append(d["particles"] * d["steps"] / d["wall"])
+            yr.append(y["particles"] * y["steps"] / y["wall"])
+            ratios.append(y["wall"] / d["wall"] - 1)
+        hook = dict(case=c, threads=t, yade_rate=statistics.median(yr), direct_rate=statistics.median(dr),
+                    overhead=statistics.median(ratios), overheads=ratios)
+        print(f"[bench] YADE hook overhead {100 * hook['overhead']:.1f} %", flush=True)
+    summary = dict(cases=rows, hook=hook, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
+                   date=time.strftime("%Y-%m-%d %H:%M:%S"))
+    with open(os.path.join(args.out, "summary.json"), "w") as f:
+        json.dump(summary, f, indent=1)
+    tab = table(rows, hook)
+    with open(os.path.join(args.out, "table.md"), "w") as f:
+        f.write(tab + "\n")
+    print(tab)
+
+
+if __name__ == "__main__":
+    main()
