@@ -82,7 +82,9 @@ struct Sym {
 template <int D>
 struct Principal {
 	Real value[3];          // σ1 ≥ σ2 ≥ σ3
-	Eigen::Matrix3d vector; // columns match value[]
+	Eigen::Matrix3d vector; // 3D: columns match value[]
+	Real c2 = 1, s2 = 0;    // 2D: cos 2θ, sin 2θ of the in-plane direction of the larger in-plane value
+	int  slot[3] = { 0, 1, 2 }; // 2D: index in value[] of the larger in-plane, smaller in-plane, zz value
 
 	static Principal of(const Sym<D>& s)
 	{
@@ -91,16 +93,18 @@ struct Principal {
 			Real a = 0.5 * (s.c[0] + s.c[1]), b = 0.5 * (s.c[0] - s.c[1]);
 			Real r = std::sqrt(b * b + s.c[3] * s.c[3]);
 			Real l1 = a + r, l2 = a - r;
-			// in-plane direction of l1
-			Real th = 0.5 * std::atan2(2 * s.c[3], s.c[0] - s.c[1]);
-			Eigen::Vector3d e1(std::cos(th), std::sin(th), 0), e2(-std::sin(th), std::cos(th), 0), ez(0, 0, 1);
-			Real v[3]            = { l1, l2, s.c[2] };
-			Eigen::Vector3d e[3] = { e1, e2, ez };
-			int o[3]             = { 0, 1, 2 };
-			std::sort(o, o + 3, [&](int i, int j) { return v[i] > v[j]; });
+			// In plane strain the directions are the in-plane pair at angle θ, 2θ = atan2(2σxy, σxx − σyy),
+			// and z. Only cos 2θ = b/r and sin 2θ = σxy/r are kept: rebuild() needs nothing else, so this
+			// per-particle path has no trigonometric calls (`vector` stays unset in 2D).
+			p.c2 = r > 0 ? b / r : 1;
+			p.s2 = r > 0 ? s.c[3] / r : 0;
+			const Real v[3] = { l1, l2, s.c[2] };
+			int        o[3] = { 0, 1, 2 }; // l1 ≥ l2 always; place σzz
+			if (v[2] > v[0]) o[0] = 2, o[1] = 0, o[2] = 1;
+			else if (v[2] > v[1]) o[1] = 2, o[2] = 1;
 			for (int k = 0; k < 3; ++k) {
-				p.value[k]      = v[o[k]];
-				p.vector.col(k) = e[o[k]];
+				p.value[k] = v[o[k]];
+				p.slot[o[k]] = k;
 			}
 		} else {
 			Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
@@ -114,6 +118,15 @@ struct Principal {
 	}
 	Sym<D> rebuild(const Real v[3]) const
 	{
+		if constexpr (D == 2) { // in-plane pair (f1 along θ, f2 across) and z: σ = ½(f1+f2) I + ½(f1−f2)[cos 2θ, sin 2θ]
+			const Real f1 = v[slot[0]], f2 = v[slot[1]], a = 0.5 * (f1 + f2), b = 0.5 * (f1 - f2);
+			Sym<D>     s;
+			s.c[0] = a + b * c2;
+			s.c[1] = a - b * c2;
+			s.c[2] = v[slot[2]];
+			s.c[3] = b * s2;
+			return s;
+		}
 		Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
 		for (int k = 0; k < 3; ++k) m += v[k] * vector.col(k) * vector.col(k).transpose();
 		return Sym<D>::fromFull(m);
