@@ -84,7 +84,7 @@ public:
 			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
 			initDamageThresholds(old);
 		}
-		needSort = true;
+		needSort = needCheck = true;
 	}
 
 	void setMaterial(const ElasticMat& m)
@@ -213,7 +213,8 @@ public:
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
 	Real maxSpeed() const { return vmax; }
 	const BlockSchedule<D>& schedule() const { return sched; }
-	void requestSort() { needSort = true; }
+	// Python calls this after writing particle views: re-sort and re-validate before the next step.
+	void requestSort() { needSort = needCheck = true; }
 
 private:
 	MaterialKind      kind = MaterialKind::None;
@@ -221,7 +222,8 @@ private:
 	DpGkMat           dpgk;
 	BlockSchedule<D>  sched;
 	StencilOffsets<D> offs;
-	bool              needSort = true;
+	bool              needSort = true;  // particles must be re-sorted by block before the next transfer
+	bool              needCheck = true; // particle data changed from outside: validate and refresh ρ_min, mass floor
 	Real              vmax = 0, rhoMin = INFINITY, massFloor = 0;
 
 	struct ErrorRecord {
@@ -261,7 +263,7 @@ private:
 	{
 		if (P.n == 0) throw InputError("particles: no particles in the solver; add particles before stepping");
 		if (kind == MaterialKind::None) throw InputError("material: no material assigned; set a material before stepping");
-		if (!std::isfinite(rhoMin) || needSort) {
+		if (!std::isfinite(rhoMin) || needCheck) {
 			Real mmin = INFINITY;
 			rhoMin    = INFINITY;
 			const Vec lo = grid.origin, hi = grid.upper();
@@ -286,6 +288,7 @@ private:
 				vmax = std::max(vmax, std::sqrt(sp));
 			}
 			massFloor = 1e-14 * mmin; // nodes lighter than this carry no velocity (only roundoff-level mass)
+			needCheck = false;
 		}
 	}
 
@@ -680,12 +683,15 @@ private:
 			s.c[0] = sx + 2 * w * sxy;
 			s.c[1] = sy - 2 * w * sxy;
 			s.c[3] = sxy + w * (sy - sx);
-		} else {
-			Eigen::Matrix3d W, S = s.full();
-			for (int a = 0; a < 3; ++a)
-				for (int b = 0; b < 3; ++b) W(a, b) = 0.5 * (L[a][b] - L[b][a]) * dt;
-			S += W * S - S * W;
-			s = Sym<D>::fromFull(S);
+		} else { // σ + WσΔt − σWΔt = σ + M + Mᵀ with M = WσΔt (W antisymmetric)
+			const Real w01 = 0.5 * (L[0][1] - L[1][0]) * dt, w02 = 0.5 * (L[0][2] - L[2][0]) * dt, w12 = 0.5 * (L[1][2] - L[2][1]) * dt;
+			const Real xx = s.c[0], yy = s.c[1], zz = s.c[2], xy = s.c[3], xz = s.c[4], yz = s.c[5];
+			s.c[0] = xx + 2 * (w01 * xy + w02 * xz);
+			s.c[1] = yy + 2 * (w12 * yz - w01 * xy);
+			s.c[2] = zz - 2 * (w02 * xz + w12 * yz);
+			s.c[3] = xy + w01 * (yy - xx) + w02 * yz + w12 * xz;
+			s.c[4] = xz + w01 * yz + w02 * (zz - xx) - w12 * xy;
+			s.c[5] = yz - w01 * xz - w02 * xy + w12 * (zz - yy);
 		}
 	}
 	static Real jacobian(const Real (&L)[D][D], Real dt)

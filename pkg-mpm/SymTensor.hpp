@@ -96,8 +96,9 @@ struct Principal {
 			// In plane strain the directions are the in-plane pair at angle θ, 2θ = atan2(2σxy, σxx − σyy),
 			// and z. Only cos 2θ = b/r and sin 2θ = σxy/r are kept: rebuild() needs nothing else, so this
 			// per-particle path has no trigonometric calls (`vector` stays unset in 2D).
-			p.c2 = r > 0 ? b / r : 1;
-			p.s2 = r > 0 ? s.c[3] / r : 0;
+			const Real ir = r > 0 ? 1 / r : 0;
+			p.c2          = r > 0 ? b * ir : 1;
+			p.s2          = s.c[3] * ir;
 			const Real v[3] = { l1, l2, s.c[2] };
 			int        o[3] = { 0, 1, 2 }; // l1 ≥ l2 always; place σzz
 			if (v[2] > v[0]) o[0] = 2, o[1] = 0, o[2] = 1;
