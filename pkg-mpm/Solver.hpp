@@ -162,15 +162,29 @@ public:
 		double t1 = omp_get_wtime();
 		phase.sort += t1 - t0;
 		withMaterial([&](const auto& mat) {
-			double a = omp_get_wtime();
-			p2g(mat);
-			double b = omp_get_wtime();
-			gridUpdate(dt);
-			// contact(dt): PTS contact with rigid bodies (Eqs. 23–26) is applied to the nodes here.
-			double c = omp_get_wtime();
-			g2p();
-			gridMusl();
-			double d = omp_get_wtime();
+			// The grid phases run in one parallel region (orphaned worksharing loops inside each phase):
+			// a thread team is woken once per step, not once per phase, which matters when other
+			// processes share the cores. Every thread takes the same error branch after a barrier.
+			double a = omp_get_wtime(), b = a, c = a, d = a;
+			errP2G.clear(), errG2P.clear();
+#pragma omp parallel
+			{
+				p2g(mat);
+#pragma omp master
+				b = omp_get_wtime();
+				if (errP2G.none()) {
+					gridUpdate(dt);
+					// contact(dt): PTS contact with rigid bodies (Eqs. 23–26) is applied to the nodes here.
+#pragma omp master
+					c = omp_get_wtime();
+					g2p();
+					if (errG2P.none()) gridMusl();
+				}
+#pragma omp master
+				d = omp_get_wtime();
+			}
+			throwIf(errP2G, "P2G");
+			throwIf(errG2P, "G2P");
 			updateStress(mat, dt);
 			double e = omp_get_wtime();
 			phase.p2g += b - a;
@@ -229,12 +243,15 @@ private:
 	struct ErrorRecord {
 		size_t      particle = SIZE_MAX;
 		std::string what;
+		void        clear() { particle = SIZE_MAX, what.clear(); }
+		bool        none() const { return particle == SIZE_MAX; }
 		void record(size_t p, const std::string& w)
 		{
 #pragma omp critical(mpm_error)
 			if (p < particle) particle = p, what = w;
 		}
 	};
+	ErrorRecord errP2G, errG2P; // shared by the threads of the transfer region
 
 	static std::string fmt(Real v)
 	{
@@ -299,10 +316,10 @@ private:
 		for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) f(size_t(p));
 	}
 	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums).
+	// Called by every thread of the step's parallel region (orphaned worksharing loops).
 	template <class F>
 	void scatterPass(F&& f)
 	{
-#pragma omp parallel
 		for (int c = 0; c < Dim<D>::nColours; ++c) {
 			const auto& blocks = sched.colour[c];
 #pragma omp for schedule(dynamic, 1)
@@ -332,11 +349,11 @@ private:
 	void p2g(const Mat& mat)
 	{
 		auto& nodes = grid.nodes;
-#pragma omp parallel for schedule(static)
+#pragma omp for schedule(static)
 		for (size_t i = 0; i < nodes.size(); ++i) lanes(nodes[i]) = NodeLanes {}; // padding lanes too
 		const Real  s = loadScale(time);
 		const Real  Dinv = 3.0 / (grid.spacing * grid.spacing); // interior M⁻¹ gradient factor
-		ErrorRecord err;
+		ErrorRecord& err = errP2G;
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
@@ -392,7 +409,6 @@ private:
 				}
 			}
 		});
-		throwIf(err, "P2G");
 	}
 	// Lane vector of a node: m, mw, a…, b… (and zero padding in 2D).
 	static NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
@@ -443,7 +459,7 @@ private:
 	{
 		auto&      nodes = grid.nodes;
 		const Real alpha = damping, mf = massFloor;
-#pragma omp parallel for schedule(static)
+#pragma omp for schedule(static)
 		for (size_t i = 0; i < nodes.size(); ++i) {
 			Node<D>&      nd  = nodes[i];
 			const uint8_t fix = grid.fixMask[i];
@@ -468,7 +484,7 @@ private:
 	{
 		auto&       nodes = grid.nodes;
 		const Real  Dinv  = 3.0 / (grid.spacing * grid.spacing);
-		ErrorRecord err;
+		ErrorRecord& err = errG2P;
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
@@ -520,7 +536,6 @@ private:
 				}
 			}
 		});
-		throwIf(err, "G2P");
 	}
 	// Interior gather of a nodal vector field u (lanes first..first+D−1): u_p = Σ w_i u_i and
 	// ∇u_p = Σ u_i ⊗ ∇ψ_i with ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7).
@@ -558,7 +573,7 @@ private:
 	{
 		auto&      nodes = grid.nodes;
 		const Real mf    = massFloor;
-#pragma omp parallel for schedule(static)
+#pragma omp for schedule(static)
 		for (size_t i = 0; i < nodes.size(); ++i) {
 			Node<D>&      nd  = nodes[i];
 			const uint8_t fix = grid.fixMask[i];
