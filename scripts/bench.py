@@ -182,10 +182,10 @@ def run_yade(name, steps, warmup):
     O.dt = 1.0
     O.run(warmup, True)
     s.resetPhaseTimes()
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     O.run(steps, True)
-    wall = time.perf_counter() - t0
-    return dict(steps=steps, wall=wall, phases=s.phaseTimes(), particles=s.numParticles, threads=ym.getThreads())
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles, threads=ym.getThreads())
 
 
 def child(args):
@@ -234,7 +234,7 @@ def summarise(case, runs):
     return row
 
 
-def table(rows, hook):
+def table(rows, hooks):
     out = ["| case | particles | threads | M p-steps/s (median; min–max) | M p-steps per CPU-s | ns/p-step | sort / P2G / grid / G2P+MUSL / stress [ns/p-step] | bytes/particle (storage; peak RSS) |",
            "|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -248,9 +248,11 @@ def table(rows, hook):
     for c in CASES:
         if (c, 1) in by and (c, 2) in by:
             out.append(f"- {c}: 2 threads / 1 thread = {by[(c, 2)]['particle_steps_per_s'] / by[(c, 1)]['particle_steps_per_s']:.2f}")
-    if hook:
-        out.append(f"- YADE hook ({hook['case']}, {hook['threads']} threads): O.run {hook['yade_rate'] / 1e6:.2f} M p-steps/s vs direct "
-                   f"{hook['direct_rate'] / 1e6:.2f} M → overhead {100 * hook['overhead']:.1f} % (median of paired runs)")
+    for hook in hooks:
+        out.append(f"- YADE hook ({hook['case']}, {hook['threads']} thread(s)): O.run {hook['yade_rate'] / 1e6:.2f} M p-steps/s vs direct "
+                   f"{hook['direct_rate'] / 1e6:.2f} M; overhead (median of {len(hook['overheads'])} paired runs) "
+                   f"{100 * hook['overhead']:.1f} % in wall time, {100 * hook['cpu_overhead']:.1f} % in CPU time "
+                   f"(paired wall ratios {', '.join(f'{100 * r:+.1f} %' for r in hook['overheads'])})")
     return "\n".join(out)
 
 
@@ -304,23 +306,26 @@ def main():
         r = rows[-1]
         print(f"[bench {k + 1}/{len(jobs)}, {time.time() - t_start:.0f} s] {c} {t}T: {r['particle_steps_per_s'] / 1e6:.2f} M p-steps/s, "
               f"{r['ns_per_particle_step']:.0f} ns/p-step", flush=True)
-    hook = None
+    hooks = []
     if not args.no_hook:
         c = "dpgk2d_80k" if "dpgk2d_80k" in cases else cases[0]
-        t = max(threads)
         _, _, _, steps, warm = CASES[c]
         if args.quick:
             steps, warm = QUICK_STEPS[c], 5
-        ratios, yr, dr = [], [], []
-        for _ in range(repeats):  # paired runs, alternating, so host noise hits both alike
-            d = spawn(c, "direct", t, steps, warm)
-            y = spawn(c, "yade", t, steps, warm)
-            dr.append(d["particles"] * d["steps"] / d["wall"])
-            yr.append(y["particles"] * y["steps"] / y["wall"])
-            ratios.append(y["wall"] / d["wall"] - 1)
-        hook = dict(case=c, threads=t, yade_rate=statistics.median(yr), direct_rate=statistics.median(dr),
-                    overhead=statistics.median(ratios), overheads=ratios)
-        print(f"[bench] YADE hook overhead {100 * hook['overhead']:.1f} %", flush=True)
+        for t in threads:
+            ratios, cpu_ratios, yr, dr = [], [], [], []
+            for _ in range(repeats):  # paired runs, alternating, so host noise hits both alike
+                d = spawn(c, "direct", t, steps, warm)
+                y = spawn(c, "yade", t, steps, warm)
+                dr.append(d["particles"] * d["steps"] / d["wall"])
+                yr.append(y["particles"] * y["steps"] / y["wall"])
+                ratios.append(y["wall"] / d["wall"] - 1)
+                cpu_ratios.append(y["cpu"] / d["cpu"] - 1)
+            hooks.append(dict(case=c, threads=t, yade_rate=statistics.median(yr), direct_rate=statistics.median(dr),
+                              overhead=statistics.median(ratios), overheads=ratios,
+                              cpu_overhead=statistics.median(cpu_ratios), cpu_overheads=cpu_ratios))
+            print(f"[bench] YADE hook overhead {t}T: wall {100 * hooks[-1]['overhead']:.1f} %, CPU time "
+                  f"{100 * hooks[-1]['cpu_overhead']:.1f} %", flush=True)
     paper = []
     if args.paper:
         for name, cfg in PAPER.items():
@@ -337,14 +342,14 @@ def main():
                                   plastic_fraction=r.get("plastic_fraction"), damaged_fraction=r.get("damaged_fraction")))
                 print(f"[bench] {name} ({r['particles']:,} particles, {t}T, C = {courant}): {rate / 1e6:.2f} M p-steps/s, "
                       f"{n:,.0f} steps → {n * r['particles'] / rate / 60:.1f} min (extrapolated)", flush=True)
-    summary = dict(cases=rows, hook=hook, paper=paper, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
+    summary = dict(cases=rows, hook=hooks, paper=paper, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
                    load_average_before=load_before, load_average_after=os.getloadavg(),
                    note="load average > 0 before the run means other processes shared the 2 cores (wall rates are then low "
                         "and noisy, 2-thread rates most)")
     with open(os.path.join(args.out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
-    tab = table(rows, hook)
+    tab = table(rows, hooks)
     if paper:
         tab += "\n\n| paper-scale scene | particles | threads | Courant C | Δt [µs] | steps to end time | M p-steps/s (measured) | wall time (extrapolated) |\n|---|---|---|---|---|---|---|---|\n"
         tab += "\n".join(f"| {p['case']} ({p['end_time'] * 1e3:g} ms) | {p['particles']:,} | {p['threads']} | {p['courant']} | {p['dt'] * 1e6:.3f} | "
