@@ -137,6 +137,17 @@ def run_paper(name, steps, warmup):
     return out
 
 
+def host_probe(nproc, secs=2.0):
+    """CPU seconds per wall second that `nproc` busy-looping processes of this job get: 1 and 2 on an
+    idle 2-core machine; less when other jobs share the cores (then 2-thread rates cannot scale)."""
+    code = ("import time\nt, c = time.time(), time.process_time()\nx = 0\n"
+            f"while time.time() - t < {secs}:\n    x += 1\nprint(time.process_time() - c)")
+    t0 = time.time()
+    ps = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(nproc)]
+    cpu = sum(float(p.communicate()[0]) for p in ps)
+    return cpu / (time.time() - t0)
+
+
 def peak_rss_bytes():
     import resource
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
@@ -293,6 +304,9 @@ def main():
     global WAIT_POLICY
     WAIT_POLICY = None if args.wait_policy == "inherit" else args.wait_policy
     load_before = os.getloadavg()
+    probe = {n: host_probe(n) for n in (1, 2)}
+    print(f"[bench] host probe: 1 busy process gets {probe[1]:.2f} CPUs, 2 get {probe[2]:.2f} CPUs "
+          f"(idle 2-core host: 1.0 and 2.0); load average {load_before[0]:.1f}", flush=True)
     os.makedirs(args.out, exist_ok=True)
     rows = []
     jobs = [(c, t) for c in cases for t in threads]
@@ -345,11 +359,15 @@ def main():
     summary = dict(cases=rows, hook=hooks, paper=paper, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
                    load_average_before=load_before, load_average_after=os.getloadavg(),
+                   cpus_available_1_process=probe[1], cpus_available_2_processes=probe[2],
                    note="load average > 0 before the run means other processes shared the 2 cores (wall rates are then low "
                         "and noisy, 2-thread rates most)")
     with open(os.path.join(args.out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
     tab = table(rows, hooks)
+    tab += (f"\n- Host during the run: load average {load_before[0]:.1f} before, {os.getloadavg()[0]:.1f} after; a busy "
+            f"process got {probe[1]:.2f} CPUs, two got {probe[2]:.2f} CPUs together (idle host: 1.0 and 2.0); "
+            f"OMP_WAIT_POLICY = {summary['omp_wait_policy']}")
     if paper:
         tab += "\n\n| paper-scale scene | particles | threads | Courant C | Δt [µs] | steps to end time | M p-steps/s (measured) | wall time (extrapolated) |\n|---|---|---|---|---|---|---|---|\n"
         tab += "\n".join(f"| {p['case']} ({p['end_time'] * 1e3:g} ms) | {p['particles']:,} | {p['threads']} | {p['courant']} | {p['dt'] * 1e6:.3f} | "
