@@ -199,8 +199,36 @@ def run_yade(name, steps, warmup):
     return dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles, threads=ym.getThreads())
 
 
+def run_hook_probe(name, steps, warmup):
+    """Child process: the fixed per-step cost of the YADE hook (PyRunner call, Δt negotiation, YADE's own
+    engines) on a tiny scene, where it is not hidden in the stepping cost: O.run vs Solver.run per step."""
+    import yade_mpm as ym
+    from yade import O
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+
+    def tiny():
+        s = ym.make_solver((0, 0), (0.1, 0.1), 0.01)
+        ym.add_region(s, ym.ElasticMat(**ROCK), (0, 0), (0.1, 0.1))
+        return s
+    a, b = tiny(), tiny()
+    e = ym.MpmEngine(a, label="mpmprobe")
+    O.engines = [ForceResetter(), e.runner(), NewtonIntegrator()]
+    O.dt = 1.0
+    O.run(warmup, True)
+    b.run(warmup)
+    ty, td = [], []
+    for _ in range(5):  # interleaved blocks, minimum of each: robust against other processes
+        t0 = time.perf_counter()
+        O.run(steps, True)
+        ty.append((time.perf_counter() - t0) / steps)
+        t0 = time.perf_counter()
+        b.run(steps)
+        td.append((time.perf_counter() - t0) / steps)
+    return dict(particles=a.numParticles, yade_step_s=min(ty), direct_step_s=min(td), hook_cost_s=min(ty) - min(td))
+
+
 def child(args):
-    fn = {"yade": run_yade, "paper": run_paper}.get(args.mode, run_direct)
+    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe}.get(args.mode, run_direct)
     res = fn(args.case, args.steps, args.warmup)
     print("BENCH " + json.dumps(res), flush=True)
 
@@ -260,9 +288,16 @@ def table(rows, hooks):
         if (c, 1) in by and (c, 2) in by:
             out.append(f"- {c}: 2 threads / 1 thread = {by[(c, 2)]['particle_steps_per_s'] / by[(c, 1)]['particle_steps_per_s']:.2f}")
     for hook in hooks:
+        if "probe" in hook:
+            pr = hook["probe"]
+            out.append(f"- YADE hook fixed cost per step (tiny scene, {pr['particles']} particles, min of 5 × 1000 steps): O.run "
+                       f"{pr['yade_step_s'] * 1e6:.0f} µs vs Solver.run {pr['direct_step_s'] * 1e6:.0f} µs → "
+                       f"{pr['hook_cost_s'] * 1e6:.0f} µs per step = " +
+                       ", ".join(f"{100 * v:.2f} % of a dpgk2d_80k step ({t}T)" for t, v in pr.get("fraction_of_step", {}).items()))
+            continue
         out.append(f"- YADE hook ({hook['case']}, {hook['threads']} thread(s)): O.run {hook['yade_rate'] / 1e6:.2f} M p-steps/s vs direct "
                    f"{hook['direct_rate'] / 1e6:.2f} M; overhead (median of {len(hook['overheads'])} paired runs) "
-                   f"{100 * hook['overhead']:.1f} % in wall time, {100 * hook['cpu_overhead']:.1f} % in CPU time "
+                   f"{100 * hook['overhead']:.1f} % in wall time "
                    f"(paired wall ratios {', '.join(f'{100 * r:+.1f} %' for r in hook['overheads'])})")
     return "\n".join(out)
 
@@ -340,6 +375,12 @@ def main():
                               cpu_overhead=statistics.median(cpu_ratios), cpu_overheads=cpu_ratios))
             print(f"[bench] YADE hook overhead {t}T: wall {100 * hooks[-1]['overhead']:.1f} %, CPU time "
                   f"{100 * hooks[-1]['cpu_overhead']:.1f} %", flush=True)
+        pr = spawn("tiny", "hookprobe", 1, 1000, 100)
+        step80k = {r["threads"]: r["particles"] / r["particle_steps_per_s"] for r in rows if r["case"] == c}
+        pr["fraction_of_step"] = {t: pr["hook_cost_s"] / st for t, st in step80k.items()}
+        hooks.append(dict(case="hook fixed cost per step", probe=pr))
+        print(f"[bench] YADE hook fixed cost {pr['hook_cost_s'] * 1e6:.0f} µs per step "
+              f"({', '.join(f'{100 * v:.2f} % of a {c} step with {t}T' for t, v in pr['fraction_of_step'].items())})", flush=True)
     paper = []
     if args.paper:
         for name, cfg in PAPER.items():
