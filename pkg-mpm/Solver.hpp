@@ -482,9 +482,8 @@ private:
 	// local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m.
 	void g2p()
 	{
-		auto&       nodes = grid.nodes;
-		const Real  Dinv  = 3.0 / (grid.spacing * grid.spacing);
-		ErrorRecord& err = errG2P;
+		auto&        nodes = grid.nodes;
+		ErrorRecord& err   = errG2P;
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
