@@ -287,13 +287,13 @@ private:
 			for (size_t p = 0; p < P.n; ++p) {
 				// State edited through the live views (requestSort() after editing) is validated like
 				// addParticles input: a NaN or off-grid position would index outside the node arrays.
-				const std::string who = "particle id " + std::to_string(P.id[p]);
+				auto who = [&] { return "particle id " + std::to_string(P.id[p]); }; // built only for a message
 				for (int a = 0; a < D; ++a)
 					if (!(P.x[a][p] >= lo[a] && P.x[a][p] < hi[a]))
-						throw InputError("position of " + who + " along axis " + std::to_string(a) + " = " + fmt(P.x[a][p]) + " m is not finite or outside the grid ["
+						throw InputError("position of " + who() + " along axis " + std::to_string(a) + " = " + fmt(P.x[a][p]) + " m is not finite or outside the grid ["
 						                 + fmt(lo[a]) + ", " + fmt(hi[a]) + ") m");
-				if (!(std::isfinite(P.mass[p]) && P.mass[p] > 0)) throw InputError("mass of " + who + " = " + fmt(P.mass[p]) + " kg must be finite and > 0");
-				if (!(std::isfinite(P.vol[p]) && P.vol[p] > 0)) throw InputError("volume of " + who + " = " + fmt(P.vol[p]) + " m³ must be finite and > 0");
+				if (!(std::isfinite(P.mass[p]) && P.mass[p] > 0)) throw InputError("mass of " + who() + " = " + fmt(P.mass[p]) + " kg must be finite and > 0");
+				if (!(std::isfinite(P.vol[p]) && P.vol[p] > 0)) throw InputError("volume of " + who() + " = " + fmt(P.vol[p]) + " m³ must be finite and > 0");
 				rhoMin = std::min(rhoMin, P.mass[p] / P.vol[p]);
 				mmin   = std::min(mmin, P.mass[p]);
 				for (int a = 0; a < D; ++a)
