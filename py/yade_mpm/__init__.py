@@ -3,6 +3,13 @@
 Core solver in C++ (pkg-mpm/, module ``yade_mpm._core``), driven from YADE's O.engines through
 ``MpmEngine``. Quantities are SI; stress is tension-positive; 2D is plane strain per unit thickness.
 """
+import os as _os
+
+# Threads that wait at a barrier should sleep rather than spin: on a loaded 2-core host a spinning
+# partner steals the core the other thread needs (measured in scripts/bench.py). Results do not
+# depend on it. Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE).
+_os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
 from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D
 from .materials import ElasticMat, DpGkMat
 from .scene import (make_solver, add_region, views, get, set_initial_stress, boundary_particles, apply_traction,
