@@ -357,6 +357,7 @@ private:
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
+			if (!k.inside) return err.record(p, "has a position outside the grid or not finite (x = " + fmt(P.x[0][p]) + ", y = " + fmt(P.x[1][p]) + ")");
 			const Real   m = P.mass[p], V = P.vol[p];
 			const Sym<D> sg = mat.forceStress(P, p);
 			Real         mv[D], mC[D][D], fe[D];

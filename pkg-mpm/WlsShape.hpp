@@ -62,6 +62,7 @@ struct Kernel {
 	Real   w[D][4]; // one-dimensional cubic B-spline weights, Eq. 13
 	Real   d[D][4]; // x_i − x_p per axis for the 4 stencil layers [m]
 	bool   general; // some stencil node is a ghost or excluded: use computeStencil
+	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
 
 template <int D>
@@ -70,8 +71,13 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 	const Real h = g.spacing, invH = 1.0 / g.spacing;
 	bool       nearEdge = false;
 	size_t     base     = 0;
+	k.inside            = true;
 	for (int a = 0; a < D; ++a) {
-		Real f  = (x[a] - g.origin[a]) * invH;
+		Real f = (x[a] - g.origin[a]) * invH;
+		if (!(f >= 0 && f < g.cells[a])) { // also catches NaN: positions edited through views
+			k.inside = false;
+			return;
+		}
 		int  c  = int(std::floor(f));
 		Real t  = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
 		Real u  = 1 - t;
@@ -153,7 +159,7 @@ inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const 
 {
 	Kernel<D> k;
 	computeKernel(g, so, x, k);
-	return fillStencil(g, so, k, st);
+	return k.inside && fillStencil(g, so, k, st);
 }
 
 } // namespace mpm

@@ -96,3 +96,14 @@ def test_grid_parameters():
         ym.Solver2D((0, 0), 1.0, (0, 4))
     with pytest.raises(ValueError, match="boundary kind"):
         _solver().addBoundaryPlane(0, -1, 0.0, "sticky")
+
+
+def test_position_corrupted_through_a_view_stops_cleanly():
+    # No requestSort() after the edit: the step itself must catch it (not crash, not write NaN).
+    s = _solver()
+    ym.add_region(s, ym.ElasticMat(young=1e9, poisson=0.2, density=2500), (0, 0), (1, 1))
+    s.step()
+    victim = int(s.view("id")[7])
+    s.view("x1")[7] = np.nan
+    with pytest.raises(ym.MpmSimulationError, match=f"step 1 .*particle id {victim} has a position outside the grid or not finite"):
+        s.step()
