@@ -76,7 +76,7 @@ def face_opening(s, geo):
     return x, 0.5 * (u[t[ot], 1] - u[b[ob], 1])
 
 
-def run_elastic(size, h, P, args, label):
+def run_elastic(size, h, P, args):
     """Quasi-static elastic run; returns a dict of profiles and errors."""
     mat = ym.ElasticMat(**ROCK)
     cp = math.sqrt((mat.young * (1 - mat.poisson) / ((1 + mat.poisson) * (1 - 2 * mat.poisson))) / mat.density)
@@ -322,7 +322,7 @@ def main(argv=None):
     wall0 = time.time()
     particles = 0
     if "elastic" in parts:
-        e = run_elastic(a.size, a.spacing, a.elastic_pressure, a, "elastic")
+        e = run_elastic(a.size, a.spacing, a.elastic_pressure, a)
         particles = max(particles, e["particles"])
         out.write_csv(os.path.join(a.out, "elastic_uy.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
                       zip(e["x"], e["uy"], e["ua"]))
@@ -338,7 +338,7 @@ def main(argv=None):
     if "convergence" in parts:
         conv = []
         for h in [float(v) for v in a.conv_spacings.split(",")]:
-            c = e if ("elastic" in parts and abs(h - a.spacing) < 1e-12) else run_elastic(a.size, h, a.elastic_pressure, a, "conv")
+            c = e if ("elastic" in parts and abs(h - a.spacing) < 1e-12) else run_elastic(a.size, h, a.elastic_pressure, a)
             conv.append(c)
             out.write_csv(os.path.join(a.out, f"elastic_uy_l{h:g}.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
                           zip(c["x"], c["uy"], c["ua"]))
