@@ -312,10 +312,10 @@ def main():
     ap.add_argument("--no-hook", action="store_true", help="skip the YADE O.run comparison")
     ap.add_argument("--paper", action="store_true", help="also time the paper-scale penny crack (250 k) and tunnel (83 k) "
                     "scenes and extrapolate their full wall time")
-    ap.add_argument("--wait-policy", choices=["active", "passive", "inherit"], default="passive",
-                    help="OMP_WAIT_POLICY for the runs (default passive: threads sleep at barriers instead of spinning, "
-                         "which keeps 2-thread runs usable when other processes share the 2 cores; 'inherit' keeps the "
-                         "environment's setting)")
+    ap.add_argument("--wait-policy", choices=["active", "passive", "inherit"], default="inherit",
+                    help="OMP_WAIT_POLICY for the runs (default inherit: what a user gets, i.e. yade_mpm's short "
+                         "GOMP_SPINCOUNT then sleep; passive sleeps at once, which suits a host whose cores are "
+                         "shared with other jobs; active spins, best on an idle host)")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--mode", default="direct", help=argparse.SUPPRESS)
     ap.add_argument("--case", help=argparse.SUPPRESS)
@@ -399,6 +399,7 @@ def main():
                       f"{n:,.0f} steps → {n * r['particles'] / rate / 60:.1f} min (extrapolated)", flush=True)
     summary = dict(cases=rows, hook=hooks, paper=paper, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
+                   gomp_spincount=os.environ.get("GOMP_SPINCOUNT", "10000 (yade_mpm default)"),
                    load_average_before=load_before, load_average_after=os.getloadavg(),
                    cpus_available_1_process=probe[1], cpus_available_2_processes=probe[2],
                    note="load average > 0 before the run means other processes shared the 2 cores (wall rates are then low "

@@ -5,10 +5,11 @@ Core solver in C++ (pkg-mpm/, module ``yade_mpm._core``), driven from YADE's O.e
 """
 import os as _os
 
-# Threads that wait at a barrier should sleep rather than spin: on a loaded 2-core host a spinning
-# partner steals the core the other thread needs (measured in scripts/bench.py). Results do not
-# depend on it. Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE).
-_os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+# Threads that wait at a barrier spin only briefly (~10 µs) and then sleep: spinning long steals the
+# core a descheduled partner needs on a loaded 2-core host, sleeping at once slows the ~12 barriers
+# of a step on an idle one (both measured with scripts/bench.py). Results do not depend on it.
+# Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE); users may override.
+_os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
 from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D
 from .materials import ElasticMat, DpGkMat
