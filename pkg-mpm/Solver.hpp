@@ -380,16 +380,7 @@ private:
 					}
 					A[b] = nodeLanes(0, 0, ca, fa);
 				}
-				forRows(k, [&](size_t row, Real wr, const Real* dr) {
-					NodeLanes R = P0;
-					for (int b = 1; b < D; ++b) R += A[b] * dr[b - 1];
-					R *= wr;
-					const NodeLanes S = A[0] * wr;
-					for (int i = 0; i < 4; ++i) { // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
-						const Real wx = k.w[0][i];
-						lanes(nodes[row + i]) += wx * R + (wx * k.d[0][i]) * S;
-					}
-				});
+				scatterAffine(k, P0, A); // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
 				return;
 			}
 			Stencil<D> st;
@@ -412,6 +403,22 @@ private:
 		});
 	}
 	// Lane vector of a node: m, mw, a…, b… (and zero padding in 2D).
+	// Interior scatter of an affine field: node i of the stencil receives w_i (base + Σ_b slope_b (x_i − x_p)_b),
+	// expanded row by row (the x-layer is the innermost loop).
+	void scatterAffine(const Kernel<D>& k, const NodeLanes& base, const NodeLanes* slope)
+	{
+		auto& nodes = grid.nodes;
+		forRows(k, [&](size_t row, Real wr, const Real* dr) {
+			NodeLanes R = base;
+			for (int b = 1; b < D; ++b) R += slope[b] * dr[b - 1];
+			R *= wr;
+			const NodeLanes S = slope[0] * wr;
+			for (int i = 0; i < 4; ++i) {
+				const Real wx = k.w[0][i];
+				lanes(nodes[row + i]) += wx * R + (wx * k.d[0][i]) * S;
+			}
+		});
+	}
 	static NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
 	{
 		if constexpr (D == 2) return NodeLanes { m, mw, a[0], a[1], b[0], b[1], 0, 0 };
@@ -504,16 +511,7 @@ private:
 						H[b] = nodeLanes(0, 0, zero, mc);
 					}
 				}
-				forRows(k, [&](size_t row, Real wr, const Real* dr) { // Eq. 16 numerator, Σ w m h_p(x_i)
-					NodeLanes R = H[D];
-					for (int b = 1; b < D; ++b) R += H[b] * dr[b - 1];
-					R *= wr;
-					const NodeLanes S = H[0] * wr;
-					for (int i = 0; i < 4; ++i) {
-						const Real wx = k.w[0][i];
-						lanes(nodes[row + i]) += wx * R + (wx * k.d[0][i]) * S;
-					}
-				});
+				scatterAffine(k, H[D], H); // Eq. 16 numerator, Σ w m h_p(x_i)
 				return;
 			}
 			Stencil<D> st;
