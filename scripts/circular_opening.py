@@ -84,7 +84,7 @@ def check_args(a):
     if a.ppc < 1 or a.ppc > 4:
         raise ValueError(f"--ppc = {a.ppc} must be in [1, 4]")
     if a.boundary_load == "consistent":
-        consistent_row_weights(a.ppc)                 # raises for ppc = 1
+        ym.consistent_row_weights(a.ppc)              # raises for ppc = 1
     if not 0 <= a.damping < 1:
         raise ValueError(f"--damping = {a.damping} must be in [0, 1)")
     if not (math.isfinite(a.tol) and a.tol > 0):
@@ -112,48 +112,14 @@ def p_wave_speed():
     return math.sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / rho)
 
 
-def bspline3(t):
-    """Cubic B-spline weight of the solver's WLS shape functions (paper Eq. 13), t in cells."""
-    t = np.abs(t)
-    return np.where(t < 1, 0.5 * t ** 3 - t ** 2 + 2 / 3, np.where(t < 2, (2 - t) ** 3 / 6, 0.0))
-
-
-def consistent_row_weights(ppc):
-    """Shares β_k (Σβ = 1) of the boundary traction carried by the particle rows k = 0, 1, … counted
-    from a free face, such that the nodal forces of the traction cancel, node by node, the internal
-    force (Eq. 21) of the uniform in-situ stress (discrete equilibrium of the intact block).
-
-    With the interior WLS closed form (ψ_i = w_i, ∇ψ_i = w_i·3/l²·(x_i − x_p)) the internal force of a
-    uniform stress near a face is not the one the outermost row alone delivers through ψ_i, so a
-    traction on that row alone leaves a self-equilibrated residual that halves the stress of the
-    outer particle row. The problem factorises per axis, so a 1D solve over 3·ppc rows is exact, also
-    at the corners. Cells are the unit of length here."""
-    rows = (np.arange(10 * ppc) + 0.5) / ppc           # particle rows inside the face at x = 0
-    nodes = np.arange(-2, 7)                          # node columns whose support the first rows touch
-    # internal force per unit stress (up to the common factor V·Σw_y): Σ_k w_i(x_k)(x_i − x_k)·3
-    f_int = np.array([np.sum(bspline3(i - rows) * (i - rows)) * 3 / ppc for i in nodes])
-    for n in range(1, 5 * ppc + 1):                   # fewest rows that balance every node exactly
-        A = np.array([[bspline3(i - x) for x in rows[:n]] for i in nodes])
-        a = np.linalg.lstsq(A, f_int, rcond=None)[0]
-        if np.abs(A @ a - f_int).max() < 1e-9 * np.abs(f_int).max():
-            return a / a.sum()
-    raise ValueError(f"--ppc = {ppc}: no exact consistent boundary load; use --boundary-load outer-row")
-
-
 def apply_far_field(s, lo, hi, spacing, ppc, sxx, syy, boundary_load="consistent"):
     """Far-field traction t = σ0·n (σ0 = diag(sxx, syy), tension positive [Pa]) on the four faces of the
     block [lo, hi]: spread over the outer rows with consistent_row_weights, or on the outermost row."""
-    dp = spacing / ppc                            # particle spacing = face length of a boundary particle
-    beta = consistent_row_weights(ppc) if boundary_load == "consistent" else np.array([1.0])
     for axis, far in ((0, sxx), (1, syy)):
-        x = s.view(f"x{axis}")                    # storage slots, as apply_traction expects (before stepping)
-        for side in (-1, 1):
-            depth = (x - lo[axis]) if side < 0 else (hi[axis] - x)
-            row = np.round(depth / dp - 0.5).astype(int)   # 0 = outermost particle row
+        for side, face in ((-1, lo[axis]), (1, hi[axis])):
             t = np.zeros(2)
             t[axis] = side * far                  # σ0·n with n = side·e_axis: compression pushes inwards
-            for k, b in enumerate(beta):
-                ym.apply_traction(s, np.nonzero(row == k)[0], b * t, dp * 1.0)  # face length × 1 m
+            ym.apply_face_traction(s, axis, side, face, t, ppc, consistent=(boundary_load == "consistent"))
 
 
 def build(spacing, domain, ppc, damping, boundary_load="consistent"):

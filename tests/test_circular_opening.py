@@ -79,11 +79,10 @@ def test_far_field_load_keeps_intact_block_in_equilibrium(mode, bound):
 
 
 def test_consistent_row_weights_sum_to_one():
-    co = load_script()
     for ppc in (2, 3, 4):
-        assert co.consistent_row_weights(ppc).sum() == pytest.approx(1.0)
-    with pytest.raises(ValueError, match="--ppc"):
-        co.consistent_row_weights(1)
+        assert ym.consistent_row_weights(ppc).sum() == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="ppc = 1"):
+        ym.consistent_row_weights(1)
 
 
 def test_bad_input_is_refused():

@@ -134,3 +134,51 @@ def apply_traction(solver, indices, traction, area):
     except ValueError:
         old = 0.0
     solver.setParticleForces(np.asarray(indices, np.int64), old + t * area)
+
+
+def _bspline3(t):
+    """Cubic B-spline weight of the WLS shape functions (Eq. 13), t in cells."""
+    t = np.abs(t)
+    return np.where(t < 1, 0.5 * t ** 3 - t ** 2 + 2 / 3, np.where(t < 2, (2 - t) ** 3 / 6, 0.0))
+
+
+def consistent_row_weights(ppc):
+    """Shares β_k (Σβ = 1) of a face traction carried by the particle rows k = 0, 1, … counted from a
+    free face, such that the nodal forces of the traction cancel, node by node, the internal force
+    (Eq. 21) of the matching uniform stress: an intact block loaded this way stays in equilibrium.
+
+    With the interior WLS closed form (ψ_i = w_i, ∇ψ_i = w_i·3/l²·(x_i − x_p)) the internal force of a
+    uniform stress near a face is not what a traction on the outermost row alone delivers through ψ_i;
+    that leaves a self-equilibrated residual that halves the stress of the outer particle row (measured
+    on the circular opening). The problem factorises per axis, so a 1D solve over 3·ppc rows is exact,
+    also at corners. Valid for a flat face on a cell boundary of the grid with ppc particles per cell
+    per axis and no other free face within 3 cells. Cells are the unit of length here."""
+    rows = (np.arange(10 * ppc) + 0.5) / ppc           # particle rows inside the face at x = 0
+    nodes = np.arange(-2, 7)                          # node columns whose support the first rows touch
+    # internal force per unit stress (up to the common factor V·Σw_y): Σ_k w_i(x_k)(x_i − x_k)·3
+    f_int = np.array([np.sum(_bspline3(i - rows) * (i - rows)) * 3 / ppc for i in nodes])
+    for n in range(1, 5 * ppc + 1):                   # fewest rows that balance every node exactly
+        A = np.array([[_bspline3(i - x) for x in rows[:n]] for i in nodes])
+        a = np.linalg.lstsq(A, f_int, rcond=None)[0]
+        if np.abs(A @ a - f_int).max() < 1e-9 * np.abs(f_int).max():
+            return a / a.sum()
+    raise ValueError(f"ppc = {ppc}: no exact consistent face load exists; load the outer row (consistent=False)")
+
+
+def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=True):
+    """Traction t [Pa] (a D-vector, e.g. σ0·n) on the flat face x_axis = face [m] of a particle lattice
+    with ppc particles per cell per axis, side = -1 when the material lies above the face, +1 below.
+    consistent=True spreads it over the outer rows with consistent_row_weights (recommended: exact
+    equilibrium with a uniform stress); False puts it all on the outermost row. Call before stepping."""
+    if side not in (-1, 1):
+        raise ValueError(f"side = {side} must be -1 (material above the face) or +1 (material below)")
+    if not (0 <= axis < dim_of(solver)):
+        raise ValueError(f"axis = {axis} must be in [0, {dim_of(solver) - 1}]")
+    dp = solver.spacing / ppc                         # particle spacing = face length of a boundary particle
+    beta = consistent_row_weights(ppc) if consistent else np.array([1.0])
+    x = solver.view(f"x{axis}")
+    depth = (x - face) if side < 0 else (face - x)
+    row = np.round(depth / dp - 0.5).astype(int)      # 0 = outermost particle row
+    area = dp ** (dim_of(solver) - 1)                 # 2D: face length × 1 m thickness
+    for k, b in enumerate(beta):
+        apply_traction(solver, np.nonzero(row == k)[0], b * np.asarray(traction, float), area)
