@@ -339,6 +339,12 @@ private:
 		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
 		computeKernel(grid, offs, x, k);
 	}
+	std::string positionText(size_t p) const
+	{
+		std::string t = "(";
+		for (int a = 0; a < D; ++a) t += (a ? ", " : "") + fmt(P.x[a][p]);
+		return t + ") m";
+	}
 	Real dxOf(const Stencil<D>& st, int n, int a) const { return st.d[a][Stencil<D>::along(n, a)]; }
 
 	// ---------------------------------------------------------------- P2G: Eqs. 20–22
@@ -357,7 +363,7 @@ private:
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
-			if (!k.inside) return err.record(p, "has a position outside the grid or not finite (x = " + fmt(P.x[0][p]) + ", y = " + fmt(P.x[1][p]) + ")");
+			if (!k.inside) return err.record(p, "has a position outside the grid or not finite: " + positionText(p));
 			const Real   m = P.mass[p], V = P.vol[p];
 			const Sym<D> sg = mat.forceStress(P, p);
 			Real         mv[D], mC[D][D], fe[D];
@@ -402,7 +408,6 @@ private:
 			}
 		});
 	}
-	// Lane vector of a node: m, mw, a…, b… (and zero padding in 2D).
 	// Interior scatter of an affine field: node i of the stencil receives w_i (base + Σ_b slope_b (x_i − x_p)_b),
 	// expanded row by row (the x-layer is the innermost loop).
 	void scatterAffine(const Kernel<D>& k, const NodeLanes& base, const NodeLanes* slope)
@@ -419,6 +424,7 @@ private:
 			}
 		});
 	}
+	// Lane vector of a node: m, mw, a…, b… (and zero padding in 2D).
 	static NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
 	{
 		if constexpr (D == 2) return NodeLanes { m, mw, a[0], a[1], b[0], b[1], 0, 0 };
