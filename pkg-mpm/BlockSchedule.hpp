@@ -22,6 +22,7 @@ struct BlockSchedule {
 	std::vector<uint32_t> colour[1 << D];      // non-empty blocks per colour
 	std::vector<uint32_t> perm, count, key;    // sort work arrays (kept: no allocation while stepping)
 	std::vector<Real>     tmp;
+	std::vector<int64_t>  idTmp;
 
 	size_t blockCount() const
 	{
@@ -49,16 +50,7 @@ struct BlockSchedule {
 		}
 		return b;
 	}
-	// Is a particle at cell coordinates `cell` still close enough to block b?
-	bool within(size_t b, const int* cell) const
-	{
-		IVec bc = blockCoords(b);
-		for (int a = 0; a < D; ++a)
-			if (cell[a] < bc[a] * B - margin || cell[a] >= (bc[a] + 1) * B + margin) return false;
-		return true;
-	}
-
-	// The same test as bounds on the fractional cell coordinate (x − origin)/l, per axis.
+	// Fractional cell coordinates (x − origin)/l a particle of block b may reach, per axis, before a re-sort.
 	void reach(size_t b, Real* lo, Real* hi) const
 	{
 		IVec bc = blockCoords(b);
@@ -83,7 +75,7 @@ struct BlockSchedule {
 		start.assign(count.begin(), count.end());
 		perm.resize(P.n);
 		for (size_t p = 0; p < P.n; ++p) perm[count[key[p]]++] = uint32_t(p);
-		P.permute(perm, tmp);
+		P.permute(perm, tmp, idTmp);
 		for (auto& c : colour) c.clear();
 		for (size_t b = 0; b < nb; ++b) {
 			if (start[b] == start[b + 1]) continue;

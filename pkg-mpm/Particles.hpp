@@ -67,16 +67,17 @@ struct Particles {
 	}
 
 	// Applies particle order perm (new slot k holds old particle perm[k]) to every field.
-	void permute(const std::vector<uint32_t>& perm, std::vector<Real>& tmp)
+	// tmp, idTmp: work buffers kept by the caller, so a re-sort allocates nothing once they have grown.
+	void permute(const std::vector<uint32_t>& perm, std::vector<Real>& tmp, std::vector<int64_t>& idTmp)
 	{
 		tmp.resize(n);
 		forEachRealField([&](std::vector<Real>& a) {
 			for (size_t k = 0; k < n; ++k) tmp[k] = a[perm[k]];
 			std::copy(tmp.begin(), tmp.begin() + n, a.begin());
 		});
-		std::vector<int64_t> ids(n);
-		for (size_t k = 0; k < n; ++k) ids[k] = id[perm[k]];
-		std::copy(ids.begin(), ids.end(), id.begin()); // keep the buffer: Python views must stay valid
+		idTmp.resize(n);
+		for (size_t k = 0; k < n; ++k) idTmp[k] = id[perm[k]];
+		std::copy(idTmp.begin(), idTmp.begin() + n, id.begin()); // keep the buffer: Python views must stay valid
 	}
 	size_t bytesPerParticle() const
 	{
