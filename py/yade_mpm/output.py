@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from .scene import SYM_NAMES, dim_of, get
+from .scene import SYM_NAMES, dim_of, get, id_order
 
 
 def _b64(arr):
@@ -45,18 +45,23 @@ def write_vtu(path, points, point_data):
 def particle_fields(solver):
     """Every particle field, in particle-id order, as a dict ready for write_vtu."""
     d = dim_of(solver)
-    pos = get(solver, "pos")
-    fields = {"id": get(solver, "id"), "velocity": get(solver, "vel"), "mass": get(solver, "mass"),
-              "volume": get(solver, "volume")}
-    st = get(solver, "stress")
+    order = id_order(solver)                      # one sort for all fields
+
+    def field(name):
+        return get(solver, name, order)
+
+    pos = field("pos")
+    fields = {"id": field("id"), "velocity": field("vel"), "mass": field("mass"),
+              "volume": field("volume")}
+    st = field("stress")
     for k, c in enumerate(SYM_NAMES[d]):
         fields[f"stress_{c}"] = st[:, k]
-    fields["max_principal_stress"] = get(solver, "max_principal_stress")
+    fields["max_principal_stress"] = field("max_principal_stress")
     fields["max_tensile_principal_stress"] = np.maximum(fields["max_principal_stress"], 0.0)
     if solver.materialKind == 1:
-        fields["damage"] = get(solver, "damage")
-        fields["plastic_strain"] = get(solver, "plastic_strain")
-        fields["cohesion"] = get(solver, "cohesion")
+        fields["damage"] = field("damage")
+        fields["plastic_strain"] = field("plastic_strain")
+        fields["cohesion"] = field("cohesion")
         # crack indicators used by the paper's figures: tensile crack = fully damaged particle,
         # shear crack = plastic strain past the softening end (cohesion at its 0.1 c0 floor)
         m = solver.dpgkParameters()
