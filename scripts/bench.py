@@ -39,26 +39,20 @@ CASES = {
 QUICK_STEPS = {"elastic2d_80k": 100, "elastic2d_1m": 15, "dpgk2d_80k": 100, "elastic3d_500k": 10}
 
 SPACING = 0.01  # grid spacing l [m]; 2 particles per cell per axis
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500)  # the paper's granite-like rock
 
 
 def build_scene(dim, material, cells):
     """The benchmark block: rock on a fixed floor with slip side walls, deformed by an initial
     pure-shear velocity field v = ε̇ (x − x_c) along x and −ε̇ (y − y_c) along y, so the stress grows
     to the DP–GK yield and damage thresholds within the warm-up. Returns the solver."""
-    import math
-    import numpy as np
     import yade_mpm as ym
+    from yade_mpm import rocks
     size = [c * SPACING for c in cells]
     lo, hi = (0.0,) * dim, tuple(size)
     s = ym.make_solver(lo, hi, SPACING, margin=3)
-    if material == "elastic":
-        mat = ym.ElasticMat(**ROCK)
-    else:
-        # Cohesion and Weibull parameters chosen so that, at this strain rate, about half of the
-        # particles are plastic and a part of them damages during the timed steps.
-        mat = ym.DpGkMat(**ROCK, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
-                         critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
+    # the paper's granite (Sec. 3.1), elastic or with the DP–GK parameters of Sec. 3.2: at this strain
+    # rate most particles yield and damage during the timed steps
+    mat = rocks.granite() if material == "elastic" else rocks.granite_dpgk()
     ym.add_region(s, mat, lo, hi, ppc=2)
     s.addBoundaryPlane(1, -1, 0.0, "fixed")
     s.addBoundaryPlane(0, -1, 0.0, "slip")
@@ -84,36 +78,14 @@ PAPER = {
 
 
 def build_paper(name):
-    import math
-    import numpy as np
     import yade_mpm as ym
+    from yade_mpm import cases, rocks
     if name == "penny_paper_250k":
-        rock = dict(young=22.41e9, poisson=0.2313, density=2500.0)
-        mat = ym.DpGkMat(**rock, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125),
-                         cohesion=24.8e6, critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
-        L, h, c, P = 5.0, 0.02, 0.2, 75e6
-        s = ym.make_solver((0, 0), (L, L), h, margin=2)
-        xc = yc = round(L / 2 / h) * h
-        ym.add_region(s, mat, (0, 0), (L, L), ppc=2, holes=[ym.Box((xc - c, yc - h), (xc + c, yc + h))])
-        x, y, dp = s.view("x0"), s.view("x1"), h / 2
-        along = np.abs(x - xc) < c
-        top = np.nonzero(along & (np.abs(y - (yc + h + dp / 2)) < dp / 4))[0]
-        bot = np.nonzero(along & (np.abs(y - (yc - h - dp / 2)) < dp / 4))[0]
-        ym.apply_traction(s, top, (0.0, P), dp)
-        ym.apply_traction(s, bot, (0.0, -P), dp)
-        s.damping = 0.05
-        s.tractionRampTime = 2e-4  # full pressure within the warm-up: damage grows at the tips while timed
+        # full pressure within the warm-up: damage grows at the tips while timed
+        s, _ = cases.line_crack(5.0, 0.02, rocks.granite_dpgk(), 75e6, ramp=2e-4, damping=0.05)
         return s
-    rock = dict(young=18.4e9, poisson=0.12, density=2364.0)
-    mat = ym.DpGkMat(**rock, frictionAngle=math.radians(39), dilatancyAngle=math.radians(9.75), cohesion=25e6,
-                     critPlasticStrain=0.1, weibullK=7.0e35, weibullM=9.0)
-    W, h = 0.15, 1e-3
-    s = ym.make_solver((0, 0), (W, W), h, margin=2)
-    cx, y0 = W / 2, 0.055  # tunnel floor height [m]
-    holes = [ym.Box((cx - 0.02, y0), (cx + 0.02, y0 + 0.025)), ym.Circle((cx, y0 + 0.025), 0.02)]
-    ym.add_region(s, mat, (0, 0), (W, W), ppc=2, holes=holes)
-    for axis, side, pos in ((0, -1, 0.0), (0, 1, W), (1, -1, 0.0)):
-        s.addBoundaryPlane(axis, side, pos, "slip")
+    h = 1e-3
+    s = cases.arch_tunnel(h, rocks.pan2020_sandstone())   # slip walls left, right, bottom
     top = ym.boundary_particles(s, 1, +1)
     ym.apply_traction(s, top, (0.0, -60e6), h / 2)
     s.tractionRampTime = 5e-3
@@ -208,7 +180,7 @@ def run_hook_probe(name, steps, warmup):
 
     def tiny():
         s = ym.make_solver((0, 0), (0.1, 0.1), 0.01)
-        ym.add_region(s, ym.ElasticMat(**ROCK), (0, 0), (0.1, 0.1))
+        ym.add_region(s, ym.rocks.granite(), (0, 0), (0.1, 0.1))
         return s
     a, b = tiny(), tiny()
     e = ym.MpmEngine(a, label="mpmprobe")

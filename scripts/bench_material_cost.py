@@ -5,16 +5,13 @@ loading, so no particle yields or damages: the extra cost is the checks alone).
     /usr/bin/python3 scripts/bench_material_cost.py --out out/bench_material
 """
 import argparse
-import math
 import os
 import time
 
 import yade_mpm as ym
 import yade_mpm.output as out
+from yade_mpm import rocks
 
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
-DPGK = dict(frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
-            critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
 
 
 def measure(mat, size, h, steps):
@@ -43,9 +40,9 @@ def main():
     ap.add_argument("--repeat", type=int, default=3, help="best of this many runs")
     a = ap.parse_args()
     ym.setThreads(a.threads)
-    cases = {"elastic": ym.ElasticMat(**ROCK),
-             "dpgk_off": ym.DpGkMat(**ROCK, **DPGK, plasticity=False, damage=False),
-             "dpgk_full": ym.DpGkMat(**ROCK, **DPGK)}
+    cases = {"elastic": rocks.granite(),
+             "dpgk_off": rocks.granite_dpgk(plasticity=False, damage=False),
+             "dpgk_full": rocks.granite_dpgk()}
     res = {}
     for name, mat in cases.items():
         runs = [measure(mat, a.size, a.spacing, a.steps) for _ in range(a.repeat)]

@@ -35,11 +35,9 @@ import yade_mpm as ym
 import yade_mpm.output as out
 from yade_mpm import kirsch
 
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
-CENTER = 2.5          # hole centre x = y [m] (paper)
-RADIUS = 0.1          # a [m] (diameter 0.2 m)
-SXX_FAR = 20e6        # far-field compression [Pa], compression positive
-SYY_FAR = 10e6
+from yade_mpm import cases, rocks, runner
+from yade_mpm.cases import OPENING_CENTER as CENTER, OPENING_RADIUS as RADIUS, OPENING_SXX as SXX_FAR, OPENING_SYY as SYY_FAR
+
 MPa = 1e6
 
 
@@ -107,33 +105,6 @@ def default_ladder(l, domain):
     return [round(x, 12) for x in (4 * l, 2 * l, 1.5 * l, l) if fits(x, domain)][-3:]
 
 
-def p_wave_speed():
-    E, nu, rho = ROCK["young"], ROCK["poisson"], ROCK["density"]
-    return math.sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / rho)
-
-
-def apply_far_field(s, lo, hi, spacing, ppc, sxx, syy, boundary_load="consistent"):
-    """Far-field traction t = σ0·n (σ0 = diag(sxx, syy), tension positive [Pa]) on the four faces of the
-    block [lo, hi]: spread over the outer rows with consistent_row_weights, or on the outermost row."""
-    for axis, far in ((0, sxx), (1, syy)):
-        for side, face in ((-1, lo[axis]), (1, hi[axis])):
-            t = np.zeros(2)
-            t[axis] = side * far                  # σ0·n with n = side·e_axis: compression pushes inwards
-            ym.apply_face_traction(s, axis, side, face, t, ppc, consistent=(boundary_load == "consistent"))
-
-
-def build(spacing, domain, ppc, damping, boundary_load="consistent"):
-    """Solver with the holed block in in-situ equilibrium and the far-field traction on its faces."""
-    lo, hi = np.full(2, CENTER - domain / 2), np.full(2, CENTER + domain / 2)
-    s = ym.make_solver(lo, hi, spacing, margin=2)
-    ym.add_region(s, ym.ElasticMat(**ROCK), lo, hi, ppc=ppc, holes=[ym.Circle((CENTER, CENTER), RADIUS)])
-    sxx, syy = -SXX_FAR, -SYY_FAR                 # tension positive inside the solver
-    ym.set_initial_stress(s, (sxx, syy, ROCK["poisson"] * (sxx + syy), 0.0))  # plane strain σzz = ν(σxx + σyy)
-    apply_far_field(s, lo, hi, spacing, ppc, sxx, syy, boundary_load)
-    s.damping = damping
-    return s
-
-
 class LineSamples:
     """Particles of the two rows straddling y = 2.5 m (x-line) and x = 2.5 m (y-line), by particle id,
     with Kirsch evaluated at their initial positions (displacements are ~1e-4 m, far below l)."""
@@ -162,28 +133,26 @@ class LineSamples:
 
 def relax(s, samples, args, spacing, label):
     """Run to the quasi-static state; returns (converged, check history)."""
-    cp = p_wave_speed()
+    cp = rocks.granite().pWaveSpeed()
     transit = args.domain / cp
     max_time = args.max_time or 40 * transit
     check_dt = 2 * RADIUS * 5 / cp             # P-wave time over 5 hole diameters between checks
-    prog = ym.Progress(max_time, label, args.progress)
-    prev = samples.vector(s)
+    prev = [samples.vector(s)]
     history = []
-    converged = False
-    while s.time < max_time:
-        t_next = min(s.time + check_dt, max_time)
-        while s.time < t_next:
-            s.step()
-            prog.update(s.steps, s.time)
+    converged = [False]
+
+    def check(s):
         cur = samples.vector(s)
-        change = float(np.max(np.abs(cur - prev))) / SXX_FAR
+        change = float(np.max(np.abs(cur - prev[0]))) / SXX_FAR
         history.append((s.steps, s.time, change, s.kineticEnergy()))
-        prev = cur
+        prev[0] = cur
         if change < args.tol and s.time > 2 * transit:  # at least one P-wave round trip through the block
-            converged = True
-            break
-    prog.update(s.steps, s.time, force=True)
-    return converged, history
+            converged[0] = True
+            return runner.STOP
+
+    runner.run(s, end_time=max_time, progress=args.progress, label=label,
+               outputs=[runner.Output(check, period=check_dt, at_end=True)])
+    return converged[0], history
 
 
 def l2_rel(sim, ref, mask):
@@ -251,7 +220,7 @@ def evaluate(s, samples, spacing, ppc, domain):
 
 def run_case(spacing, args, label):
     t0 = time.time()
-    s = build(spacing, args.domain, args.ppc, args.damping, args.boundary_load)
+    s, _, _ = cases.circular_opening(spacing, args.domain, args.ppc, args.damping, args.boundary_load)
     samples = LineSamples(s, spacing, args.ppc)
     converged, hist = relax(s, samples, args, spacing, label)
     wall = time.time() - t0

@@ -29,11 +29,10 @@ import yade_mpm as ym
 import yade_mpm.output as out
 from yade_mpm import sneddon
 
-# Paper Sec. 3.2 rock
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
-DPGK = dict(frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
-            critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
-HALF_CRACK = 0.2                       # c [m]
+from yade_mpm import cases, rocks, runner
+
+ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
+HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
 PAPER_RAMP = 0.5                       # s
 PAPER_DA = [(0.1, 7), (0.2, 22), (0.4, 72)]   # Fig. 9: (t [s], Δa [cells of 0.02 m])
 PAPER_CELL = 0.02                      # m
@@ -41,30 +40,8 @@ SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures
 
 
 def build(size, h, material, P, ramp, damping, crack_nodes="shared"):
-    """Solver with the cracked block; returns (solver, crack geometry dict). crack_nodes = "excluded"
-    takes the grid nodes on the crack's mid-line out of the WLS fits: the cubic B-spline reaches 2 cells,
-    so with "shared" the two faces (2 cells apart) both map to that node row and stay weakly tied."""
-    s = ym.make_solver((0, 0), (size, size), h, margin=2)
-    xc = yc = round(size / 2 / h) * h   # crack centre on a grid line so the hole is exactly two cell layers
-    crack = ym.Box((xc - HALF_CRACK, yc - h), (xc + HALF_CRACK, yc + h))  # two cell layers
-    ym.add_region(s, material, (0, 0), (size, size), ppc=2, holes=[crack])
-    x0 = ym.get(s, "pos")               # ids == storage slots before the first step
-    dp = h / 2                          # particle spacing
-    along = np.abs(x0[:, 0] - xc) < HALF_CRACK
-    top = along & (np.abs(x0[:, 1] - (yc + h + dp / 2)) < dp / 4)
-    bot = along & (np.abs(x0[:, 1] - (yc - h - dp / 2)) < dp / 4)
-    # pressure P on the faces: traction −P n, n the outward normal of the solid (−y on the upper face)
-    ym.apply_traction(s, np.nonzero(top)[0], (0.0, P), dp)
-    ym.apply_traction(s, np.nonzero(bot)[0], (0.0, -P), dp)
-    if crack_nodes == "excluded":
-        xn = s.nodePositions()
-        inner = (np.abs(xn[:, 1] - yc) < h / 4) & (np.abs(xn[:, 0] - xc) < HALF_CRACK - h / 4)
-        for i in np.nonzero(inner)[0]:
-            s.setNodeExcluded(int(i), True)
-    s.damping = damping
-    s.tractionRampTime = ramp
-    geo = dict(xc=xc, yc=yc, h=h, dp=dp, x0=x0, top=np.nonzero(top)[0], bot=np.nonzero(bot)[0])
-    return s, geo
+    """The cracked block (yade_mpm.cases.line_crack); returns (solver, crack geometry dict)."""
+    return cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK)
 
 
 def face_opening(s, geo):
@@ -78,24 +55,23 @@ def face_opening(s, geo):
 
 def run_elastic(size, h, P, args):
     """Quasi-static elastic run; returns a dict of profiles and errors."""
-    mat = ym.ElasticMat(**ROCK)
+    mat = rocks.granite()
     cp = math.sqrt((mat.young * (1 - mat.poisson) / ((1 + mat.poisson) * (1 - 2 * mat.poisson))) / mat.density)
     transit = size / cp
     s, geo = build(size, h, mat, P, ramp=2 * transit, damping=args.elastic_damping, crack_nodes=args.crack_nodes)
     t0 = time.time()
-    prog = ym.Progress(args.elastic_max_transits * transit, f"elastic h={h}", args.progress)
     ref = sneddon.opening_displacement(0.0, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
     hist = []
-    while s.time < args.elastic_max_transits * transit:
-        t_next = s.time + 0.25 * transit
-        while s.time < t_next:
-            s.step()
-        prog.update(s.steps, s.time)
+
+    def check(s):
         hist.append(face_opening(s, geo)[1].max())
         # converged once the load is on and the centre opening varies by < tol·u_Sneddon over the last
         # transit (4 samples, so a sample pair at the two turning points of an oscillation cannot pass)
         if s.time > 3 * transit and len(hist) >= 5 and np.ptp(hist[-5:]) < args.elastic_tol * ref:
-            break
+            return runner.STOP
+
+    runner.run(s, end_time=args.elastic_max_transits * transit, progress=args.progress, label=f"elastic h={h}",
+               every=[(0.25 * transit, check)])
     wall = time.time() - t0
     x, uy = face_opening(s, geo)
     ua = sneddon.opening_displacement(x, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
@@ -165,35 +141,36 @@ def run_damage(args, law, outdir):
     size, h = args.size, args.damage_spacing
     ramp = PAPER_RAMP if args.full else args.ramp_time
     scale = PAPER_RAMP / ramp                                  # t_paper = scale · t
-    mat = ym.DpGkMat(**ROCK, **DPGK, growthLaw=law)
+    mat = rocks.granite_dpgk(growthLaw=law)
     s, geo = build(size, h, mat, args.damage_pressure, ramp=ramp, damping=args.damage_damping, crack_nodes=args.crack_nodes)
     if args.threshold_volume == "cube":
         # sensitivity study: Eq. 37 with V = (particle spacing)³ instead of area × 1 m
         s.view("eps0")[:] = mat.activationStrain(geo["dp"] ** 3)
     t_end = args.end_time / scale
     rec_dt = args.record_every / scale
-    prog = ym.Progress(t_end, f"damage law {law}", args.progress)
-    rows, snaps = [], list(SNAP_T)
+    rows = []
     t0 = time.time()
-    next_rec = 0.0
-    while s.time < t_end:
-        s.step()
-        prog.update(s.steps, s.time)
-        tp = s.time * scale
-        if s.time >= next_rec or s.time >= t_end:
-            left, right = crack_extension(s, geo, args.band)
-            dm = s.view("damage")
-            rows.append((tp, args.damage_pressure * min(1.0, s.time / ramp), left, right,
-                         int(np.count_nonzero(dm >= 1)), int(np.count_nonzero(dm > 0)),
-                         int(np.count_nonzero(s.view("epsP") > 0)), time.time() - t0))
-            next_rec += rec_dt
-        while snaps and tp >= snaps[0] - 1e-12:
-            tag = f"law{law}_t{snaps[0]:.2f}s"
+
+    def record(s):
+        left, right = crack_extension(s, geo, args.band)
+        dm = s.view("damage")
+        rows.append((s.time * scale, args.damage_pressure * min(1.0, s.time / ramp), left, right,
+                     int(np.count_nonzero(dm >= 1)), int(np.count_nonzero(dm > 0)),
+                     int(np.count_nonzero(s.view("epsP") > 0)), time.time() - t0))
+
+    def snapshot(tp):
+        def write(s):
+            tag = f"law{law}_t{tp:.2f}s"
             damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
-                       f"D, growth law {law}, t_paper = {snaps[0]} s (P = {args.damage_pressure * snaps[0] / PAPER_RAMP / 1e6:.0f} MPa)")
+                       f"D, growth law {law}, t_paper = {tp} s (P = {args.damage_pressure * tp / PAPER_RAMP / 1e6:.0f} MPa)")
             if args.vtu:
                 out.write_particles(os.path.join(outdir, f"damage_{tag}.vtu"), s)
-            snaps.pop(0)
+        return runner.Output(write, times=[tp / scale])
+
+    n_rec = int(math.ceil(t_end / rec_dt))
+    runner.run(s, end_time=t_end, progress=args.progress, label=f"damage law {law}",
+               outputs=[runner.Output(record, times=np.arange(n_rec) * rec_dt, at_end=True)]
+               + [snapshot(tp) for tp in SNAP_T])
     wall = time.time() - t0
     header = ["t_paper_s", "P_Pa", "da_left_cells", "da_right_cells", "broken_particles", "damaged_particles",
               "plastic_particles", "wall_s"]

@@ -36,9 +36,7 @@ ENERGY_TOL = 0.02
 # fraction of the largest input energy of the run (the first steps of a gravity load move ~1e-12 J).
 ENERGY_FLOOR = 1e-3
 
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)  # paper's granite (Table 1)
-ROCK_DPGK = dict(ROCK, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
-                 critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
+from yade_mpm import rocks, runner  # the paper's granite: rocks.granite() (elastic), rocks.granite_dpgk()
 
 
 # ----------------------------------------------------------------------------------------------- scenes
@@ -98,7 +96,7 @@ def case_soft(fast):
 
 
 def rock_rate(fast, speedup):
-    mat = ym.DpGkMat(**ROCK_DPGK)
+    mat = rocks.granite_dpgk()
     # 20 MPa compression, ramped over 20 transit times / speedup; run 30 transit times either way.
     s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast))
     s.gravity = (0.0, -9.81)
@@ -120,7 +118,7 @@ def case_overload(fast):
     Mohr–Coulomb uniaxial strength 2c·cosφ/(1 − sinφ) ≈ 90 MPa: the block is crushed, a loaded top corner
     particle is squeezed out sideways and leaves the grid (2 margin cells on the left), which must stop the
     run with the grid-edge message."""
-    mat = ym.DpGkMat(**ROCK_DPGK)
+    mat = rocks.granite_dpgk()
     s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), extra_x=0.5, extra_y=0.5)
     s.gravity = (0.0, -9.81)
     top_traction(s, h, 2, -200e6, 0.0)
@@ -147,7 +145,7 @@ def case_damaged(fast):
     and the tensile waves from the velocity jump (up to ρ c_p Δv/2 ≈ 40 MPa) drive more particles to D = 1. A velocity pull is used
     rather than a top traction: a traction keeps accelerating the loaded layer once the rock beneath it is
     fully damaged, which then flies off the grid (that variant stops with the grid-edge error)."""
-    mat = ym.DpGkMat(**ROCK_DPGK)
+    mat = rocks.granite_dpgk()
     s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), extra_y=0.2)
     s.gravity = (0.0, -9.81)
     y = s.view("x1")
@@ -161,7 +159,7 @@ def case_grid_edge(fast):
     """Elastic rock block thrown at 100 m/s towards +x with 2 margin cells and no walls: it must be
     stopped with a message naming the particle that leaves the grid (WLS fits near the edge use the
     reduced node set on the way)."""
-    mat = ym.ElasticMat(**ROCK)
+    mat = rocks.granite()
     cells = cells_per_m(fast)
     s = ym.make_solver((0.0, 0.0), (0.5, 0.5), 0.5 / cells, margin=2)
     ym.add_region(s, mat, (0.0, 0.0), (0.5, 0.5), ppc=2)
@@ -192,7 +190,7 @@ def case_edge_deforming(fast):
     """Rock block filling the grid to its edges (margin 0, no side walls), gravity and a 20 MPa top
     compression ramped over 2 transits: the outer particles deform in cells whose stencils reach past the
     grid, where the WLS fit uses the reduced node set (Eqs. 10, 15 with M assembled from active nodes)."""
-    mat = ym.ElasticMat(**ROCK)
+    mat = rocks.granite()
     s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), margin=0)
     s.gravity = (0.0, -9.81)
     tt = transit_time(mat, 1.0)
@@ -275,27 +273,32 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
     e0 = s.kineticEnergy() + s.elasticEnergy()
     hist = {"t": [], "total": [], "input": [], "dt_ratio": [], "dt_ratio_paper": []}
     outcome, message, nan_seen = "finished", "", False
-    prog = ym.Progress(end_time, name, 10.0) if progress else None
+    limit = [None]
     wall0 = time.time()
+
+    def before(s):
+        limit[0] = s.stableDt()  # C·l/(v_c + max‖v‖) from the state before the step
+
+    def check(s):
+        nonlocal nan_seen, outcome, message
+        after = s.spacing / (s.waveSpeed() + s.maxSpeed)  # paper's Δt ≤ l/(v_c+|v|), C = 1, after the step
+        tot = s.kineticEnergy() + s.elasticEnergy()
+        hist["t"].append(s.time)
+        hist["total"].append(tot)
+        hist["input"].append(e0 + s.externalWork)
+        hist["dt_ratio"].append(s.lastDt / limit[0])
+        hist["dt_ratio_paper"].append(s.lastDt / after)
+        bad = nonfinite_state(s)
+        if bad or not math.isfinite(tot):
+            nan_seen = True
+            outcome = "nan_not_stopped"
+            message = f"non-finite {bad or 'energy'} at step {s.steps} not caught by the solver"
+            return runner.STOP
+
     try:
-        while s.time < end_time * (1 - 1e-12) and (max_steps is None or s.steps < max_steps):
-            limit = s.stableDt()  # C·l/(v_c + max‖v‖) from the state before the step
-            s.step()
-            after = s.spacing / (s.waveSpeed() + s.maxSpeed)  # paper's Δt ≤ l/(v_c+|v|), C = 1, after the step
-            tot = s.kineticEnergy() + s.elasticEnergy()
-            hist["t"].append(s.time)
-            hist["total"].append(tot)
-            hist["input"].append(e0 + s.externalWork)
-            hist["dt_ratio"].append(s.lastDt / limit)
-            hist["dt_ratio_paper"].append(s.lastDt / after)
-            bad = nonfinite_state(s)
-            if bad or not math.isfinite(tot):
-                nan_seen = True
-                outcome = "nan_not_stopped"
-                message = f"non-finite {bad or 'energy'} at step {s.steps} not caught by the solver"
-                break
-            if prog:
-                prog.update(s.steps, s.time)
+        runner.run(s, end_time=end_time, max_steps=None if max_steps is None else max(0, max_steps - s.steps),
+                   progress=10.0 if progress else None, label=name, before_step=before,
+                   outputs=[runner.Output(check, steps=1)])
     except ym.MpmSimulationError as e:
         outcome, message = "stopped_with_error", str(e)
         nan_seen = nonfinite_state(s) is not None

@@ -2,7 +2,6 @@
 import numpy as np
 import yade_mpm as ym
 
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0)
 
 
 def bar_2d(cells_x=64, cells_y=4, length=1.0, mat=None, ppc=2):

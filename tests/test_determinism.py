@@ -18,9 +18,7 @@ import json, math, sys
 import numpy as np
 import yade_mpm as ym
 dim, nsteps = int(sys.argv[1]), int(sys.argv[2])
-rock = dict(young=22.41e9, poisson=0.2313, density=2500)
-mat = ym.DpGkMat(**rock, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
-                 critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
+mat = ym.rocks.granite_dpgk()
 l = 0.01
 if dim == 2:
     hi = (0.6, 0.3)

@@ -8,18 +8,17 @@ import pytest
 
 import yade_mpm as ym
 
-E, NU, RHO = 22.41e9, 0.2313, 2500.0
+P = ym.rocks.GRANITE_DPGK               # the paper's Sec. 3.2 rock
+E, NU, RHO = P["young"], P["poisson"], P["density"]
 K = E / (3 * (1 - 2 * NU))
 G = E / (2 * (1 + NU))
 M = K + 4 * G / 3
-PHI, PSI, C0 = math.radians(32.5), math.radians(8.125), 24.8e6
+PHI, PSI, C0 = P["frictionAngle"], P["dilatancyAngle"], P["cohesion"]
+WK, WM = P["weibullK"], P["weibullM"]
 
 
 def mat(**kw):
-    base = dict(young=E, poisson=NU, density=RHO, frictionAngle=PHI, dilatancyAngle=PSI, cohesion=C0,
-                critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
-    base.update(kw)
-    return ym.DpGkMat(**base)
+    return ym.rocks.granite_dpgk(**kw)
 
 
 def dp_coeffs(phi):
@@ -111,11 +110,11 @@ def test_parameters_match_the_printed_formulas():
     assert m.cohesionAt(0.05) == pytest.approx(0.5 * C0, rel=1e-14)
     assert m.cohesionAt(0.09) == pytest.approx(0.1 * C0, rel=1e-12)
     assert m.cohesionAt(5.0) == 0.1 * C0
-    assert m.activationStrain(1e-4) == pytest.approx((1e-4 * 1.1798e29) ** (-1 / 7.5), rel=1e-14)
-    mm = 7.5
-    assert m.alpha() == pytest.approx(8 * math.pi * 1.1798e29 * (mm + 3) ** 2 / ((mm + 1) * (mm + 2)), rel=1e-14)
+    assert m.activationStrain(1e-4) == pytest.approx((1e-4 * WK) ** (-1 / WM), rel=1e-14)
+    mm = WM
+    assert m.alpha() == pytest.approx(8 * math.pi * WK * (mm + 3) ** 2 / ((mm + 1) * (mm + 2)), rel=1e-14)
     # Eq. 39 α equals Benz & Asphaug's prefactor: (m+3)/3 · α_BA^(1/3) = ⅓ α^(1/3) for c_g = 1
-    a_ba = 8 * math.pi * 1.1798e29 / ((mm + 1) * (mm + 2) * (mm + 3))
+    a_ba = 8 * math.pi * WK / ((mm + 1) * (mm + 2) * (mm + 3))
     assert (mm + 3) / 3 * a_ba ** (1 / 3) == pytest.approx(m.alpha() ** (1 / 3) / 3, rel=1e-12)
     assert m.effectiveCrackSpeed() == pytest.approx(0.4 * math.sqrt(M / RHO), rel=1e-14)
 
@@ -293,7 +292,7 @@ def test_plane_strain_compression_path_against_independent_integration():
 
 
 # ------------------------------------------------------------------ GK damage, Eqs. 35–40
-def rate_closed_form(eb, law, m_=7.5, k=1.1798e29):
+def rate_closed_form(eb, law, m_=WM, k=WK):
     a = 8 * math.pi * k * (m_ + 3) ** 2 / ((m_ + 1) * (m_ + 2))
     cg = 0.4 * math.sqrt(M / RHO)
     return cg * a ** (1 / 3) / 3 * (eb ** (m_ / 3) if law == 0 else eb ** (1 / 3))

@@ -4,6 +4,7 @@ with the DP–GK rock. The full-size numbers come from scripts/penny_crack.py (d
 import json
 import math
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -12,8 +13,19 @@ import pytest
 import yade_mpm as ym
 from yade_mpm import sneddon
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
-import penny_crack  # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def run_script(argv):
+    """scripts/penny_crack.py through its command line (one thread, this checkout's package);
+    returns its summary.json."""
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"), OMP_NUM_THREADS="1")
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "penny_crack.py"), *argv], env=env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = argv[argv.index("--out") + 1]
+    with open(os.path.join(out, "summary.json")) as f:
+        return json.load(f)
 
 
 @pytest.fixture(autouse=True)
@@ -26,7 +38,7 @@ def one_thread():
 
 
 def test_sneddon_formulas():
-    E, nu, P, c = 22.41e9, 0.2313, 15e6, 0.2
+    E, nu, P, c = ym.rocks.GRANITE["young"], ym.rocks.GRANITE["poisson"], 15e6, ym.cases.CRACK_HALF_LENGTH
     # Eq. 43 with a = c is the ellipse 2P(1 − ν²)/E √(c² − x²); zero at and beyond the tips
     assert sneddon.opening_displacement(0.0, P, E, nu, c) == pytest.approx(2 * P * (1 - nu ** 2) / E * c, rel=1e-14)
     assert sneddon.opening_displacement(0.2, P, E, nu, c) == 0.0
@@ -46,7 +58,7 @@ def test_sneddon_formulas():
 def test_elastic_opening_and_tip_stress_small_block(tmp_path):
     """2.5 m block, l = 0.04 m (15.6 k particles): the finite block opens the crack a little more than
     the infinite medium of Sneddon's solution."""
-    s = penny_crack.main(["--out", str(tmp_path), "--parts", "elastic", "--size", "2.5", "--spacing", "0.04",
+    s = run_script(["--out", str(tmp_path), "--parts", "elastic", "--size", "2.5", "--spacing", "0.04",
                           "--progress", "1000"])
     assert abs(s["uy_center_rel_error"]) < 0.10
     assert s["uy_l2_rel_error"] < 0.15
@@ -63,7 +75,7 @@ def test_elastic_opening_and_tip_stress_small_block(tmp_path):
 
 def test_damage_grows_symmetrically_and_monotonically(tmp_path):
     """1.2 m block at the paper's l = 0.02 m (14 k particles), P = 75 MPa ramped over 4 ms."""
-    s = penny_crack.main(["--out", str(tmp_path), "--parts", "damage", "--size", "1.2", "--ramp-time", "0.004",
+    s = run_script(["--out", str(tmp_path), "--parts", "damage", "--size", "1.2", "--ramp-time", "0.004",
                           "--end-time", "0.2", "--record-every", "0.005", "--laws", "0", "--progress", "1000"])
     rows = np.loadtxt(tmp_path / "crack_extension_law0.csv", delimiter=",", skiprows=1)
     left, right = rows[:, 2], rows[:, 3]

@@ -103,3 +103,45 @@ def pyplot():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
+
+
+def write_pvd(path, entries):
+    """ParaView collection file indexing a time series: entries = [(time [s], file path), …]; paths are
+    written relative to the .pvd's folder. Written to a temporary file and renamed, so a reader (or an
+    interrupted run) never sees half an index."""
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n<Collection>\n')
+        for t, p in entries:
+            rel = os.path.relpath(os.path.abspath(p), folder)
+            f.write(f'<DataSet timestep="{float(t):.12g}" group="" part="0" file="{rel}"/>\n')
+        f.write('</Collection>\n</VTKFile>\n')
+    os.replace(tmp, path)
+
+
+class VtuSeries:
+    """A VTU time series of the particles with a .pvd index for ParaView: ``write(solver)`` writes
+    DIR/NAME_NNNNNNNN.vtu (the solver step) and rewrites DIR/NAME.pvd, so the index always lists
+    every file written so far (also after an interrupted run). Use as a runner callback:
+    ``runner.run(s, ..., every=[(1e-3, series.write)])``. `fields`: a function solver → (points,
+    {name: array}) (default: ``particle_fields``, every particle field)."""
+
+    def __init__(self, directory, name="particles", fields=None):
+        if not isinstance(name, str) or not name or os.sep in name:
+            raise ValueError(f"name = {name!r} must be a non-empty file name stem")
+        self.directory, self.name = directory, name
+        self.fields = fields or particle_fields
+        self.entries = []
+        self.pvd = os.path.join(directory, f"{name}.pvd")
+
+    def write(self, solver):
+        """Write the current state; returns the .vtu path. A second write at the same step replaces
+        the first (same file, one index entry)."""
+        path = os.path.join(self.directory, f"{self.name}_{int(solver.steps):08d}.vtu")
+        points, data = self.fields(solver)
+        write_vtu(path, points, data)
+        self.entries = [e for e in self.entries if e[1] != path] + [(float(solver.time), path)]
+        write_pvd(self.pvd, self.entries)
+        return path

@@ -4,24 +4,34 @@ import time
 
 
 class Progress:
-    """Call ``update(step, t)`` as often as you like; prints at most every `interval` wall seconds."""
+    """Call ``update(step, t)`` as often as you like; prints at most every `interval` wall seconds.
+    The ETA comes from the fraction done of `end_time` [s] (simulated), or else of `total_steps`."""
 
-    def __init__(self, end_time, label="mpm", interval=10.0, stream=sys.stdout):
+    def __init__(self, end_time, label="mpm", interval=10.0, stream=sys.stdout, total_steps=None):
         self.end_time, self.label, self.interval, self.stream = end_time, label, interval, stream
+        self.total_steps = total_steps
         self.start = time.time()
         self.last = self.start
-        self.t0 = None
+        self.t0 = self.step0 = None
+
+    def fraction(self, step, t):
+        """Fraction of the run done since the first update (None when neither end is known)."""
+        if self.end_time:
+            return min(1.0, (t - self.t0) / max(self.end_time - self.t0, 1e-300))
+        if self.total_steps:
+            return min(1.0, (step - self.step0) / self.total_steps)
+        return None
 
     def update(self, step, t, force=False):
         now = time.time()
         if self.t0 is None:
-            self.t0 = t
+            self.t0, self.step0 = t, step
         if not force and now - self.last < self.interval:
             return
         self.last = now
         elapsed = now - self.start
-        frac = (t - self.t0) / max(self.end_time - self.t0, 1e-300) if self.end_time else 0.0
-        eta = elapsed * (1 - frac) / frac if frac > 0 else float("nan")
-        pct = f" ({100 * frac:5.1f} %)" if self.end_time else ""
+        frac = self.fraction(step, t)
+        eta = elapsed * (1 - frac) / frac if frac else float("nan")
+        pct = f" ({100 * frac:5.1f} %)" if frac is not None else ""
         print(f"[{self.label}] step {step:9d}  t = {t:.6e} s{pct}  wall {elapsed:7.1f} s  ETA {eta:7.1f} s",
               file=self.stream, flush=True)

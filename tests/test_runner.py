@@ -1,0 +1,137 @@
+"""The one run loop (yade_mpm.runner) and the VTU series writer (yade_mpm.output.VtuSeries), on a small
+block at rest: no load, so Δt = C·l/c_p exactly (c_p the P-wave speed of the rock) and every stop and
+output time can be predicted independently of the loop."""
+import base64
+import math
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+import yade_mpm as ym
+from yade_mpm import output, rocks, runner
+
+
+def block():
+    s = ym.make_solver((0, 0), (0.2, 0.2), 0.02)
+    mat = rocks.granite()
+    ym.add_region(s, mat, (0, 0), (0.2, 0.2))
+    return s, s.courant * s.spacing / mat.pWaveSpeed()
+
+
+def test_end_time_and_max_steps():
+    s, dt = block()
+    res = runner.run(s, end_time=100.5 * dt)
+    assert res.reason == "end_time" and res.steps == 101 and s.steps == 101
+    res = runner.run(s, end_time=1.0, max_steps=17)          # max_steps counts the steps of this call
+    assert res.reason == "max_steps" and res.steps == 17 and s.steps == 118
+    assert runner.run(s, end_time=s.time).steps == 0         # already there: no step
+
+
+def test_output_triggers():
+    s, dt = block()
+    by_period, by_steps, by_times, ends = [], [], [], []
+    times = [10.5 * dt, 10.7 * dt, 40.2 * dt, 1.0]             # the last lies beyond the end
+    res = runner.run(s, end_time=60.5 * dt, outputs=[
+        runner.Output(lambda s: by_period.append(s.steps), period=7.3 * dt),
+        runner.Output(lambda s: by_steps.append(s.steps), steps=11),
+        runner.Output(lambda s: by_times.append(s.steps), times=times),
+        runner.Output(lambda s: ends.append(s.steps), at_start=True, at_end=True)])
+    assert res.steps == 61
+    # period: the first step at least 7.3 Δt after the previous call (t = 0 at the start): steps 8, 16, 24, …
+    assert by_period == list(range(8, 62, 8))
+    assert by_steps == [11, 22, 33, 44, 55]
+    assert by_times == [11, 41]                              # 10.5 and 10.7 Δt both end at step 11: one call
+    assert ends == [0, 61]
+
+
+def test_stop_criteria():
+    s, _ = block()
+    res = runner.run(s, end_time=1.0, stop=lambda s: s.steps >= 13)
+    assert res.reason == "stop" and s.steps == 13
+    calls = []
+
+    def converged(s):
+        calls.append(s.steps)
+        if len(calls) == 3:
+            return runner.STOP
+
+    res = runner.run(s, end_time=1.0, outputs=[runner.Output(converged, steps=5, at_end=True)])
+    assert res.reason == "stop" and s.steps == 28 and calls == [18, 23, 28]   # at_end: not twice at step 28
+
+
+def test_keyboard_interrupt_writes_outputs_so_far(tmp_path):
+    s, dt = block()
+    series = output.VtuSeries(str(tmp_path), "p")
+    final = []
+
+    def ctrl_c(s):
+        if s.steps == 25:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        runner.run(s, end_time=1.0, every=[(10 * dt * (1 - 1e-9), series.write)],
+                   outputs=[runner.Output(ctrl_c, steps=1), runner.Output(lambda s: final.append(s.steps), at_end=True)])
+    assert final == [25]
+    steps = [int(ds.get("file")[2:10]) for ds in ET.parse(tmp_path / "p.pvd").getroot().iter("DataSet")]
+    assert steps == [10, 20]
+    res = runner.run(s, end_time=1.0, on_interrupt="return", outputs=[runner.Output(ctrl_c, steps=1)],
+                     stop=lambda s: s.steps > 100)
+    assert res.reason == "stop"                               # step 25 is behind: no interrupt now
+    s2, _ = block()
+    res = runner.run(s2, end_time=1.0, on_interrupt="return", outputs=[runner.Output(ctrl_c, steps=1)])
+    assert res.reason == "interrupted" and s2.steps == 25
+
+
+def _decode(text):
+    raw = base64.b64decode(text.strip())
+    n = int(np.frombuffer(raw[:8], "<u8")[0])
+    return raw[8:8 + n]
+
+
+def test_vtu_series_index_and_data(tmp_path):
+    """The .pvd lists every file with its simulated time; each .vtu holds the particle positions of that
+    moment (decoded here from the base64 + UInt64-length layout ParaView expects)."""
+    s, _ = block()
+    s.view("v0")[:] = 1.0                                    # move rigidly: x(t) = x0 + t
+    s.requestSort()
+    dt = s.courant * s.spacing / (rocks.granite().pWaveSpeed() + 1.0)   # C·l/(c_p + max‖v‖)
+    x0 = ym.get(s, "pos")
+    series = output.VtuSeries(str(tmp_path / "series"))
+    runner.run(s, max_steps=30, every=[(12 * dt * (1 - 1e-9), series.write)],
+               outputs=[runner.Output(series.write, at_start=True, at_end=True)])
+    root = ET.parse(tmp_path / "series" / "particles.pvd").getroot()
+    assert root.get("type") == "Collection"
+    entries = [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
+    assert [f for _, f in entries] == [f"particles_{k:08d}.vtu" for k in (0, 12, 24, 30)]
+    for t, f in entries:
+        vtu = ET.parse(tmp_path / "series" / f).getroot()
+        piece = vtu.find("UnstructuredGrid/Piece")
+        n = int(piece.get("NumberOfPoints"))
+        assert n == s.numParticles
+        pts = np.frombuffer(_decode(piece.find("Points/DataArray").text), "<f8").reshape(n, 3)
+        ids = next(a for a in piece.iter("DataArray") if a.get("Name") == "id")
+        order = np.argsort(np.frombuffer(_decode(ids.text), "<i8"))
+        k = int(f[10:18])
+        assert t == pytest.approx(k * dt, rel=1e-12)
+        # a free block at uniform velocity translates rigidly (no stress, no gravity)
+        assert np.allclose(pts[order, 0], x0[:, 0] + t, rtol=0, atol=1e-12)
+        assert np.allclose(pts[order, 1], x0[:, 1], rtol=0, atol=1e-12)
+        assert np.all(pts[:, 2] == 0)
+
+
+@pytest.mark.parametrize("kw, name", [(dict(end_time=math.nan), "end_time"), (dict(max_steps=-1), "max_steps"),
+                                      (dict(max_steps=2.5), "max_steps"), (dict(stop=3), "stop"),
+                                      (dict(every=[(0.0, print)]), "period"), (dict(every=[print]), "every"),
+                                      (dict(outputs=[print]), "outputs"), (dict(on_interrupt="ignore"), "on_interrupt"),
+                                      (dict(progress=-1), "progress")])
+def test_bad_arguments(kw, name):
+    s, _ = block()
+    with pytest.raises(ValueError, match=name):
+        runner.run(s, **kw)
+    assert s.steps == 0
+    with pytest.raises(ValueError, match="steps"):
+        runner.Output(print, steps=0)
+    with pytest.raises(ValueError, match="at least one"):
+        runner.Output(print)
