@@ -13,41 +13,24 @@ enum class DamageGrowthLaw : int {
 };
 
 struct DpGkMat : ElasticMat {
-	Real frictionAngle     = 0;    // φ [rad]
-	Real dilatancyAngle    = 0;    // ψ [rad]
-	Real cohesion          = 0;    // c₀ [Pa]
-	Real critPlasticStrain = 0.1;  // ε̄p,crit of Eq. 34 [-]
-	Real residualCohesion  = 0.1;  // floor of Eq. 34 as a fraction of c₀ [-] (paper: 0.1)
-	Real weibullK          = 0;    // k [m⁻³]
-	Real weibullM          = 0;    // m [-]
-	Real crackSpeed        = 0;    // c_g [m/s]; 0 → 0.4 × P-wave speed
-	int  growthLaw         = 0;    // DamageGrowthLaw
-	bool plasticity        = true; // DP return mapping on/off
-	bool damage            = true; // GK damage on/off
+	MPM_PARAMS(DpGkMat, ElasticMat, MPM_DPGK_PARAMS) // plasticity, damage, φ, ψ, c₀, … (MaterialParams.hpp)
 
+	// Ranges of the table, then the conditions that tie parameters together.
 	void validate() const
 	{
-		ElasticMat::validate();
-		requireRange(frictionAngle, 0, M_PI / 2, false, true, "frictionAngle", "[rad]");
-		requireRange(dilatancyAngle, 0, frictionAngle, false, false, "dilatancyAngle", "[rad] (0 ≤ ψ ≤ φ)");
-		if (plasticity) requireRange(cohesion, 0, INFINITY, true, true, "cohesion", "[Pa]");
-		requireRange(critPlasticStrain, 0, INFINITY, true, true, "critPlasticStrain", "[-]");
-		requireRange(residualCohesion, 0, 1, false, false, "residualCohesion", "[-]");
-		if (damage) {
-			requireRange(weibullK, 0, INFINITY, true, true, "weibullK", "[m^-3]");
-			requireRange(weibullM, 0, INFINITY, true, true, "weibullM", "[-]");
-			requireRange(crackSpeed, 0, INFINITY, false, true, "crackSpeed", "[m/s]");
-		}
-		if (growthLaw != 0 && growthLaw != 1) throw InputError("growthLaw must be 0 (Benz–Asphaug, ε̄^{m/3}) or 1 (Eq. 38 as printed, ε̄^{1/3})");
+		validateParams();
+		if (plasticity && dilationAngle > frictionAngle)
+			throw InputError("dilationAngle (alias dilatancyAngle) = " + ParamInfo::num(dilationAngle) + " [rad] is outside the allowed range [0, frictionAngle = "
+			                 + ParamInfo::num(frictionAngle) + "] (ψ ≤ φ)");
 		if (plasticity && softeningModulusTerm() >= shear())
 			throw InputError(
-			        "critPlasticStrain = " + std::to_string(critPlasticStrain)
+			        "critPlasticStrain = " + ParamInfo::num(critPlasticStrain)
 			        + " gives cohesion softening steeper than the shear modulus allows (k̄φ·c₀/(√3·ε̄p,crit) must be < G); raise critPlasticStrain");
 	}
 	// Eq. 31 (outer-apex Mohr–Coulomb match) and Eq. 33.
 	Real qPhi() const { return 6 * std::sin(frictionAngle) / (std::sqrt(3.0) * (3 - std::sin(frictionAngle))); }
 	Real kPhi() const { return 6 * std::cos(frictionAngle) / (std::sqrt(3.0) * (3 - std::sin(frictionAngle))); }
-	Real qPsi() const { return 6 * std::sin(dilatancyAngle) / (std::sqrt(3.0) * (3 - std::sin(dilatancyAngle))); }
+	Real qPsi() const { return 6 * std::sin(dilationAngle) / (std::sqrt(3.0) * (3 - std::sin(dilationAngle))); }
 	// |k̄φ H|/√3, H = dc/dε̄p in the softening branch.
 	Real softeningModulusTerm() const { return kPhi() * cohesion / critPlasticStrain / std::sqrt(3.0); }
 	// Eq. 34.

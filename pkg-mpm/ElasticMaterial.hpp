@@ -1,21 +1,15 @@
 // Linear elastic rock in rate form (paper Eqs. 27–29). The elastic trial of every material goes through
 // here, so the hypoelastic law is written once.
 #pragma once
+#include "MaterialParams.hpp"
 #include "Particles.hpp"
 
 namespace mpm {
 
 struct ElasticMat {
-	Real young   = 0; // E [Pa]
-	Real poisson = 0; // ν [-]
-	Real density = 0; // ρ [kg/m³]
+	MPM_PARAMS(ElasticMat, NoParams, MPM_ELASTIC_PARAMS) // young, poisson, density (MaterialParams.hpp)
 
-	void validate() const
-	{
-		requireRange(young, 0, INFINITY, true, true, "young", "[Pa]");
-		requireRange(poisson, -1, 0.5, true, true, "poisson", "[-]");
-		requireRange(density, 0, INFINITY, true, true, "density", "[kg/m³]");
-	}
+	void validate() const { validateParams(); }
 	Real bulk() const { return young / (3 * (1 - 2 * poisson)); }  // K [Pa]
 	Real shear() const { return young / (2 * (1 + poisson)); }     // G [Pa]
 	Real pWaveModulus() const { return bulk() + 4 * shear() / 3; } // K + 4G/3 [Pa]

@@ -2,6 +2,7 @@
 // Particle fields are exposed as NumPy views on the solver's own arrays (no copy); the views keep
 // the solver alive and stay valid while stepping (arrays are never reallocated during a step).
 #include "../pkg-mpm/Solver.hpp"
+#include "param_binding.hpp"
 #include <boost/python.hpp>
 #include <boost/python/numpy.hpp>
 
@@ -324,34 +325,26 @@ BOOST_PYTHON_MODULE(_core)
 	bp::register_exception_translator<InputError>(&translateInput);
 	bp::register_exception_translator<SimulationError>(&translateSimulation);
 
-	bp::class_<ElasticMat>("ElasticMat", "Linear elastic material (Eqs. 27–29).")
-	        .def_readwrite("young", &ElasticMat::young, "Young's modulus E [Pa]")
-	        .def_readwrite("poisson", &ElasticMat::poisson, "Poisson's ratio ν [-], −1 < ν < 0.5")
-	        .def_readwrite("density", &ElasticMat::density, "density ρ [kg/m³]")
-	        .def("validate", &ElasticMat::validate)
-	        .def("bulk", &ElasticMat::bulk)
-	        .def("shear", &ElasticMat::shear)
-	        .def("pWaveSpeed", &ElasticMat::pWaveSpeed);
-	bp::class_<DpGkMat, bp::bases<ElasticMat>>("DpGkMat", "Drucker–Prager plasticity + Grady–Kipp damage rock (Eqs. 27–40).")
-	        .def_readwrite("frictionAngle", &DpGkMat::frictionAngle, "friction angle φ [rad]")
-	        .def_readwrite("dilatancyAngle", &DpGkMat::dilatancyAngle, "dilatancy angle ψ [rad]")
-	        .def_readwrite("cohesion", &DpGkMat::cohesion, "initial cohesion c₀ [Pa]")
-	        .def_readwrite("critPlasticStrain", &DpGkMat::critPlasticStrain, "critical plastic strain ε̄p,crit of Eq. 34 [-]")
-	        .def_readwrite("residualCohesion", &DpGkMat::residualCohesion, "cohesion floor as a fraction of c₀ [-]")
-	        .def_readwrite("weibullK", &DpGkMat::weibullK, "Weibull k [m⁻³]")
-	        .def_readwrite("weibullM", &DpGkMat::weibullM, "Weibull m [-]")
-	        .def_readwrite("crackSpeed", &DpGkMat::crackSpeed, "crack growth speed c_g [m/s]; 0 = 0.4 × P-wave speed")
-	        .def_readwrite("growthLaw", &DpGkMat::growthLaw, "0 = Benz–Asphaug ε̄^{m/3}, 1 = Eq. 38 as printed ε̄^{1/3}")
-	        .def_readwrite("plasticity", &DpGkMat::plasticity, "DP return mapping on/off")
-	        .def_readwrite("damage", &DpGkMat::damage, "GK damage on/off")
-	        .def("validate", &DpGkMat::validate)
-	        .def("qPhi", &DpGkMat::qPhi)
-	        .def("kPhi", &DpGkMat::kPhi)
-	        .def("qPsi", &DpGkMat::qPsi)
-	        .def("cohesionAt", &DpGkMat::cohesionAt)
-	        .def("alpha", &DpGkMat::alpha)
-	        .def("activationStrain", &DpGkMat::activationStrain)
-	        .def("effectiveCrackSpeed", &DpGkMat::effectiveCrackSpeed);
+	// Materials: properties, keyword constructors, toDict/fromDict generated from MaterialParams.hpp.
+	using EB = ParamBinding<ElasticMat>;
+	EB::declare("ElasticMat");
+	bp::class_<ElasticMat, std::shared_ptr<ElasticMat>> elasticCls("ElasticMat", EB::classDoc("Linear elastic material (Eqs. 27–29).").c_str(), bp::no_init);
+	EB::expose(elasticCls);
+	elasticCls.def("bulk", &ElasticMat::bulk, "bulk modulus K [Pa]")
+	        .def("shear", &ElasticMat::shear, "shear modulus G [Pa]")
+	        .def("pWaveSpeed", &ElasticMat::pWaveSpeed, "P-wave speed √((K + 4G/3)/ρ) [m/s]");
+	using DB = ParamBinding<DpGkMat>;
+	DB::declare("DpGkMat", { { "dilatancyAngle", "dilationAngle" } });
+	bp::class_<DpGkMat, std::shared_ptr<DpGkMat>, bp::bases<ElasticMat>> dpgkCls(
+	        "DpGkMat", DB::classDoc("Drucker–Prager plasticity + Grady–Kipp damage rock (paper Sec. 2.4, Eqs. 27–40).").c_str(), bp::no_init);
+	DB::expose(dpgkCls);
+	dpgkCls.def("qPhi", &DpGkMat::qPhi, "q_φ of Eq. 31 [-]")
+	        .def("kPhi", &DpGkMat::kPhi, "k̄_φ of Eq. 31 [-]")
+	        .def("qPsi", &DpGkMat::qPsi, "q_ψ of Eq. 33 [-]")
+	        .def("cohesionAt", &DpGkMat::cohesionAt, bp::arg("epsP"), "softened cohesion c(ε̄p) of Eq. 34 [Pa]")
+	        .def("alpha", &DpGkMat::alpha, "α of Eq. 39 [m⁻³]")
+	        .def("activationStrain", &DpGkMat::activationStrain, bp::arg("volume"), "damage threshold ε_D⁰ = (Vk)^(−1/m) of Eq. 37 [-] for a particle volume V [m³]")
+	        .def("effectiveCrackSpeed", &DpGkMat::effectiveCrackSpeed, "c_g actually used [m/s]");
 
 	SolverWrap<2>::expose("Solver2D");
 	SolverWrap<3>::expose("Solver3D");

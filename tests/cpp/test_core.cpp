@@ -54,7 +54,7 @@ void shapeChecks()
 void dpChecks()
 {
 	DpGkMat m;
-	m.young = 22.41e9, m.poisson = 0.2313, m.density = 2500, m.frictionAngle = 32.5 * M_PI / 180, m.dilatancyAngle = 8.125 * M_PI / 180;
+	m.young = 22.41e9, m.poisson = 0.2313, m.density = 2500, m.frictionAngle = 32.5 * M_PI / 180, m.dilationAngle = 8.125 * M_PI / 180;
 	m.cohesion = 24.8e6, m.critPlasticStrain = 0.1, m.weibullK = 1.1798e29, m.weibullM = 7.5, m.damage = false;
 	m.validate();
 	DruckerPragerGradyKipp<2> mat(m);

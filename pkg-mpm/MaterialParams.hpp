@@ -1,0 +1,32 @@
+// The material parameters, each declared once (see ParamTable.hpp for the columns).
+// The C++ fields, range validation, Python properties and docstrings, keyword constructors and
+// toDict/fromDict are all generated from these lists. Names follow YADE where YADE has the concept
+// (FrictMat/JCFpmMat: young, poisson, density, frictionAngle, cohesion; JCFpmMat's
+// jointDilationAngle → dilationAngle, with the paper's "dilatancyAngle" kept as a Python alias).
+#pragma once
+#include "ParamTable.hpp"
+
+// X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
+#define MPM_ELASTIC_PARAMS(X)                                                                                  \
+	X(Real, young, MPM_REQUIRED, "Pa", 0, INFINITY, OO, "E", "Young's modulus", "Eqs. 27–28", "")              \
+	X(Real, poisson, MPM_REQUIRED, "-", -1, 0.5, OO, "ν", "Poisson's ratio", "Eqs. 27–28", "")                 \
+	X(Real, density, MPM_REQUIRED, "kg/m³", 0, INFINITY, OO, "ρ", "mass density (particle mass m_p = ρV_p)", \
+	  "Eq. 20", "")
+
+// Weibull m: rocks and ceramics lie between ~3 and ~40 (Grady & Kipp 1980); below 1 the flaw
+// population is degenerate and ε_D⁰ = (Vk)^(−1/m) under/overflows (m = 1e-300 gave ε_D⁰ = 0).
+#define MPM_DPGK_PARAMS(X)                                                                                                        \
+	X(bool, plasticity, true, "-", 0, 1, CC, "", "Drucker–Prager return mapping on/off", "Eqs. 30–34", "")                       \
+	X(bool, damage, true, "-", 0, 1, CC, "", "Grady–Kipp tensile damage on/off", "Eqs. 35–40", "")                               \
+	X(Real, frictionAngle, MPM_REQUIRED, "rad", 0, M_PI / 2, CO, "φ", "friction angle", "Eqs. 30–31", "plasticity")             \
+	X(Real, dilationAngle, 0, "rad", 0, M_PI / 2, CO, "ψ", "dilation (dilatancy) angle, at most frictionAngle", \
+	  "Eqs. 32–33", "plasticity")                                                                                                \
+	X(Real, cohesion, MPM_REQUIRED, "Pa", 0, INFINITY, OO, "c₀", "initial cohesion", "Eq. 34", "plasticity")                    \
+	X(Real, critPlasticStrain, 0.1, "-", 0, INFINITY, OO, "ε̄p,crit", "accumulated plastic strain at which cohesion softening ends", \
+	  "Eq. 34", "plasticity")                                                                                                    \
+	X(Real, residualCohesion, 0.1, "-", 0, 1, CC, "", "cohesion floor as a fraction of c₀ (paper: 0.1)", "Eq. 34", "plasticity") \
+	X(Real, weibullK, MPM_REQUIRED, "m^-3", 0, INFINITY, OO, "k", "Weibull flaw density", "Eqs. 37, 39", "damage")              \
+	X(Real, weibullM, MPM_REQUIRED, "-", 1, 50, CC, "m", "Weibull modulus", "Eqs. 37–39", "damage")                              \
+	X(Real, crackSpeed, 0, "m/s", 0, INFINITY, CO, "c_g", "crack growth speed; 0 = 0.4 × P-wave speed", "Eq. 38", "damage")     \
+	X(int, growthLaw, 0, "-", 0, 1, CC, "",                                                                                      \
+	  "damage growth law: 0 = Grady–Kipp/Benz–Asphaug dD^⅓/dt ∝ ε̄^(m/3), 1 = Eq. 38 as printed ∝ ε̄^(1/3)", "Eq. 38", "damage")
