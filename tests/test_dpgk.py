@@ -13,7 +13,7 @@ E, NU, RHO = P["young"], P["poisson"], P["density"]
 K = E / (3 * (1 - 2 * NU))
 G = E / (2 * (1 + NU))
 M = K + 4 * G / 3
-PHI, PSI, C0 = P["frictionAngle"], P["dilatancyAngle"], P["cohesion"]
+PHI, PSI, C0 = P["frictionAngle"], P["dilationAngle"], P["cohesion"]
 WK, WM = P["weibullK"], P["weibullM"]
 
 

@@ -7,8 +7,7 @@ import re
 import pytest
 import yade_mpm as ym
 
-ROCK = dict(young=22.41e9, poisson=0.2313, density=2500.0, frictionAngle=math.radians(32.5),
-            dilationAngle=math.radians(8.125), cohesion=24.8e6, weibullK=1.1798e29, weibullM=7.5)
+ROCK = ym.rocks.GRANITE_DPGK                                       # the paper's Sec. 3.2 rock
 UNIT = re.compile(r"\[[^\]]+\]")                                    # "[Pa]", "[-]", "[kg/m³]"
 RANGE = re.compile(r"range [\[(][^,]+, [^\])]+[\])]|True or False")  # "range (0, inf)", bools
 

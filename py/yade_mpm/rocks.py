@@ -7,7 +7,7 @@ Raw dicts (keyword arguments of ``ElasticMat`` / ``DpGkMat``; SI units, angles i
 ``GRANITE``            elastic rock of the circular opening, paper Sec. 3.1 (granite-like):
                        E = 22.41 GPa, ν = 0.2313, ρ = 2500 kg/m³
 ``GRANITE_DPGK``       the same rock with the plasticity and damage of the penny-shaped crack,
-                       paper Sec. 3.2: φ = 32.5°, ψ = 8.125°, c₀ = 24.8 MPa, ε̄p,crit = 0.1,
+                       paper Sec. 3.2: φ = 32.5°, ψ (dilationAngle) = 8.125°, c₀ = 24.8 MPa, ε̄p,crit = 0.1,
                        k = 1.1798e29 m⁻³, m = 7.5
 ``RAYMOND2019_DAMAGE`` damage parameters of Raymond et al. (2019), used by the paper in Secs. 3.3
                        and 4: ε̄p,crit = 0.1, k = 7.0e35 m⁻³, m = 9.0
@@ -34,7 +34,7 @@ ELASTIC_KEYS = ("young", "poisson", "density")
 GRANITE = dict(young=22.41e9, poisson=0.2313, density=2500.0)
 
 # Paper Sec. 3.2 (penny-shaped crack): plasticity and damage of the same rock
-GRANITE_DPGK = dict(GRANITE, frictionAngle=math.radians(32.5), dilatancyAngle=math.radians(8.125), cohesion=24.8e6,
+GRANITE_DPGK = dict(GRANITE, frictionAngle=math.radians(32.5), dilationAngle=math.radians(8.125), cohesion=24.8e6,
                     critPlasticStrain=0.1, weibullK=1.1798e29, weibullM=7.5)
 
 # Raymond et al. (2019), used by the paper for both sandstones (Secs. 3.3 and 4)
@@ -42,11 +42,11 @@ RAYMOND2019_DAMAGE = dict(critPlasticStrain=0.1, weibullK=7.0e35, weibullM=9.0)
 
 # Miao et al. (2018), paper Sec. 3.3 (uniaxial compression with a flaw)
 MIAO2018_SANDSTONE = dict(young=9.87e9, poisson=0.22, density=2520.0, frictionAngle=math.radians(38.0),
-                          dilatancyAngle=math.radians(9.5), cohesion=13.0e6, **RAYMOND2019_DAMAGE)
+                          dilationAngle=math.radians(9.5), cohesion=13.0e6, **RAYMOND2019_DAMAGE)
 
 # Pan et al. (2020b), paper Sec. 4 (arch-shaped tunnel)
 PAN2020_SANDSTONE = dict(young=18.4e9, poisson=0.12, density=2364.0, frictionAngle=math.radians(39.0),
-                         dilatancyAngle=math.radians(9.75), cohesion=25.0e6, **RAYMOND2019_DAMAGE)
+                         dilationAngle=math.radians(9.75), cohesion=25.0e6, **RAYMOND2019_DAMAGE)
 
 SETS = {
     "granite": (GRANITE, "paper Sec. 3.1, circular opening (elastic)"),
