@@ -69,6 +69,8 @@ def test_headless_yade_script(tmp_path):
         O.run(20, True)
         print("RESULT", O.iter, s.steps, mpm.label)
     """))
+    # YADE must import the package under test, not whatever yade_mpm the global path points to.
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(ym.__file__)))
     r = subprocess.run(["yade", "-n", "-x", str(script)], capture_output=True, text=True, timeout=300,
-                       cwd=str(tmp_path))
+                       cwd=str(tmp_path), env=env)
     assert "RESULT 20 20 mpm" in r.stdout, r.stdout + r.stderr
