@@ -76,6 +76,28 @@ struct BlockSchedule {
 		perm.resize(P.n);
 		for (size_t p = 0; p < P.n; ++p) perm[count[key[p]]++] = uint32_t(p);
 		P.permute(perm, tmp, idTmp);
+		buildColours();
+	}
+
+	// Schedule of a checkpoint (py/yade_mpm/checkpoint.py): the block ranges of the last sort, for
+	// particles already stored in that sort's order. False (nothing changed) if they do not fit.
+	bool restore(const Grid<D>& g, const std::vector<uint32_t>& blockStart, size_t nParticles)
+	{
+		IVec nbk;
+		size_t nb = 1;
+		for (int a = 0; a < D; ++a) nbk[a] = (g.cells[a] + B - 1) / B, nb *= nbk[a];
+		if (blockStart.size() != nb + 1 || blockStart.front() != 0 || blockStart.back() != nParticles) return false;
+		for (size_t b = 0; b < nb; ++b)
+			if (blockStart[b + 1] < blockStart[b]) return false;
+		nBlocks = nbk;
+		start   = blockStart;
+		buildColours();
+		return true;
+	}
+
+	void buildColours()
+	{
+		const size_t nb = blockCount();
 		for (auto& c : colour) c.clear();
 		for (size_t b = 0; b < nb; ++b) {
 			if (start[b] == start[b + 1]) continue;

@@ -230,6 +230,23 @@ public:
 	// Python calls this after writing particle views: re-sort and re-validate before the next step.
 	void requestSort() { needSort = needCheck = true; }
 
+	// Checkpoint access (py/yade_mpm/checkpoint.py): with the particle arrays in storage order and the
+	// block schedule, these are everything the next step reads, so a resumed run is bitwise identical.
+	struct ResumeState {
+		long steps;
+		Real time, lastDt, externalWork, vmax, rhoMin, massFloor;
+		bool needSort, needCheck;
+	};
+	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, rhoMin, massFloor, needSort, needCheck }; }
+	void setResumeState(const ResumeState& r, const std::vector<uint32_t>& blockStart)
+	{
+		const bool neverSorted = blockStart.empty() && r.needSort; // saved before the first step
+		if (!neverSorted && !sched.restore(grid, blockStart, P.n)) throw InputError("checkpoint: the block schedule does not fit this grid and particle count");
+		steps = r.steps, time = r.time, lastDt = r.lastDt, externalWork = r.externalWork;
+		vmax = r.vmax, rhoMin = r.rhoMin, massFloor = r.massFloor;
+		needSort = r.needSort, needCheck = r.needCheck;
+	}
+
 private:
 	MaterialKind      kind = MaterialKind::None;
 	ElasticMat        elastic;

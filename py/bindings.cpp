@@ -219,6 +219,40 @@ struct SolverWrap {
 		if constexpr (D == 2) return bp::make_tuple(s.grid.stored[0], s.grid.stored[1]);
 		else return bp::make_tuple(s.grid.stored[0], s.grid.stored[1], s.grid.stored[2]);
 	}
+	// Checkpoint (py/yade_mpm/checkpoint.py): the solver state that is not in the particle views.
+	static bp::dict getResumeState(S& s)
+	{
+		const auto r = s.resumeState();
+		bp::dict   d;
+		d["steps"] = r.steps, d["time"] = r.time, d["lastDt"] = r.lastDt, d["externalWork"] = r.externalWork;
+		d["vmax"] = r.vmax, d["rhoMin"] = r.rhoMin, d["massFloor"] = r.massFloor;
+		d["needSort"] = r.needSort, d["needCheck"] = r.needCheck;
+		const auto& st = s.schedule().start;
+		np::ndarray a  = np::empty(bp::make_tuple(st.size()), np::dtype::get_builtin<uint32_t>());
+		std::copy(st.begin(), st.end(), reinterpret_cast<uint32_t*>(a.get_data()));
+		d["blockStart"] = a;
+		int nReal       = 0; // particle arrays of the scene: the checkpoint must hold every one
+		s.P.forEachRealField([&](std::vector<Real>&) { ++nReal; });
+		d["realFields"] = nReal;
+		return d;
+	}
+	static void setResumeState(S& s, bp::dict d)
+	{
+		typename S::ResumeState r;
+		r.steps        = bp::extract<long>(d["steps"]);
+		r.time         = bp::extract<double>(d["time"]);
+		r.lastDt       = bp::extract<double>(d["lastDt"]);
+		r.externalWork = bp::extract<double>(d["externalWork"]);
+		r.vmax         = bp::extract<double>(d["vmax"]);
+		r.rhoMin       = bp::extract<double>(d["rhoMin"]);
+		r.massFloor    = bp::extract<double>(d["massFloor"]);
+		r.needSort     = bp::extract<bool>(d["needSort"]);
+		r.needCheck    = bp::extract<bool>(d["needCheck"]);
+		np::ndarray a  = np::from_object(d["blockStart"], np::dtype::get_builtin<uint32_t>(), np::ndarray::C_CONTIGUOUS);
+		if (a.get_nd() != 1) throw InputError("checkpoint: blockStart must be a 1-D array");
+		auto* p = reinterpret_cast<uint32_t*>(a.get_data());
+		s.setResumeState(r, std::vector<uint32_t>(p, p + a.shape(0)));
+	}
 	static void setNodeExcluded(S& s, size_t i, bool ex) { s.grid.setExcluded(i, ex); }
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
@@ -258,6 +292,8 @@ struct SolverWrap {
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("requestSort", &S::requestSort)
+		        .def("getResumeState", &getResumeState)
+		        .def("setResumeState", &setResumeState, bp::arg("state"))
 		        .def("elasticParameters", &S::elasticParameters, bp::return_value_policy<bp::copy_const_reference>())
 		        .def("dpgkParameters", &S::dpgkParameters, bp::return_value_policy<bp::copy_const_reference>())
 		        .def("loadScale", &S::loadScale)

@@ -19,6 +19,7 @@ from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
 from .progress import Progress
 from . import rocks, cases, runner  # noqa: E402  (named rock sets, scene builders, the run loop)
+from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
            "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",

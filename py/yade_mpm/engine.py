@@ -18,7 +18,9 @@ def engine(label):
     try:
         return _registry[label]
     except KeyError:
-        raise KeyError(f"no MPM engine labelled '{label}'; known: {sorted(_registry)}") from None
+        raise KeyError(f"no MPM engine labelled '{label}'; known: {sorted(_registry)}. The registry lives in "
+                       "this Python process: after O.load (or in a new process) restore the MPM state with "
+                       "yade_mpm.checkpoint.load(...), which registers the engines again") from None
 
 
 class MpmEngine:
@@ -39,6 +41,18 @@ class MpmEngine:
         from yade.wrapper import PyRunner
         cmd = f"__import__('yade_mpm').engine({self.label!r})._yade_step()"
         return PyRunner(command=cmd, iterPeriod=1, initRun=True, label=self.label)
+
+    def checkpoint_state(self):
+        """What a resumed run needs from this engine (yade_mpm.checkpoint): the O.dt asked for by the
+        user/DEM side and the O.dt this engine set last (floats survive JSON exactly)."""
+        return {"user_dt": self.user_dt, "last_set_dt": self.last_set_dt,
+                "progress": None if self.progress is None else [self.progress.end_time, self.progress.interval]}
+
+    def restore_checkpoint_state(self, state):
+        self.user_dt, self.last_set_dt = state["user_dt"], state["last_set_dt"]
+        if state.get("progress") and self.progress is None:
+            self.progress = Progress(state["progress"][0], self.label, state["progress"][1])
+        _registry[self.label] = self
 
     def _yade_step(self):
         from yade import O

@@ -1,0 +1,473 @@
+"""Checkpoint and resume of a whole simulation: the MPM solvers and the YADE scene.
+
+    import yade_mpm as ym
+    build_my_scene()                          # solver(s), MpmEngine(s), YADE bodies and engines
+    if resuming:
+        ym.checkpoint.load("run.ckpt")        # fills the freshly built scene with the saved state
+    ...
+    ym.checkpoint.save("run.ckpt")            # between O.run(n, True) calls (or Solver.run calls)
+
+A checkpoint holds, per MPM solver, every particle array in storage order (the particles are sorted
+by block, so the order is state), the clock (time, steps, last Δt), the external work, the block
+schedule of the last sort and the values the next step reads without recomputing them (whether a
+re-sort is due, max‖v‖, ρ_min, the nodal mass floor), plus the solver settings. With YADE it also
+holds the YADE scene written by ``O.save`` (bodies and their state, engines, O.time, O.iter, O.dt),
+the body states once more (checked bitwise after ``O.load``) and the state of the Python-side engines
+(``MpmEngine``: the O.dt the user asked for). A run resumed from it is bitwise identical to the
+uninterrupted run for the same thread count.
+
+The scene itself is not rebuilt from the file: the script builds it as usual (same grid, particles,
+materials, bodies) and ``load`` overwrites the state. ``load`` first reads and checks the whole file
+and refuses, with a ``CheckpointError`` (a ``ValueError``) and nothing changed, a truncated or
+corrupted file, one written by another checkpoint format or another build of the core, or one whose
+scene differs from the one built (grid, particle count, masses, initial volumes, loads, material,
+YADE bodies and engines). After ``O.load`` the ``MpmEngine`` registry (the PyRunner commands name the
+engines by label) is restored, so ``yade_mpm.engine(label)`` works again.
+
+``Checkpointer`` adds the run-loop side: a checkpoint every N steps or every M wall minutes, and
+SIGINT / SIGTERM turned into "write a last checkpoint and the outputs, then stop cleanly".
+"""
+import hashlib
+import io
+import json
+import os
+import signal
+import struct
+import sys
+import time
+
+import numpy as np
+
+from . import _core
+from .engine import MpmEngine, _registry as _engines
+from .scene import SYM_NAMES, dim_of
+
+FORMAT = 1
+MAGIC = b"YADE-MPM-CHECKPOINT\n"
+_STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
+# Solver settings: state too (a script may change them during a run), restored from the checkpoint.
+_SETTINGS = ("damping", "courant", "fixedDt", "tractionRampTime", "sortPeriod", "autoDt", "trackEnergy")
+
+
+class CheckpointError(ValueError):
+    """A checkpoint that cannot be loaded into this scene (truncated, corrupted, other version or scene)."""
+
+
+# ----------------------------------------------------------------------------------------- build id
+_BUILD = None
+
+
+def build_id():
+    """Identity of the compiled core (SHA-256 of yade_mpm/_core*.so, 16 hex digits): a bitwise resume
+    needs the same build, so a checkpoint records it and ``load`` refuses another one."""
+    global _BUILD
+    if _BUILD is None:
+        h = hashlib.sha256()
+        with open(_core.__file__, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+        _BUILD = h.hexdigest()[:16]
+    return _BUILD
+
+
+# ------------------------------------------------------------------------------------ solver state
+def _field_names(solver):
+    d = dim_of(solver)
+    return ([f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"C{k}" for k in range(d * d)]
+            + ["mass", "vol", "vol0"] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
+            + [f"trac{a}" for a in range(d)] + ["epsP", "damage", "eps0"])
+
+
+def _particle_arrays(solver):
+    """Every allocated particle array (live views, storage order), keyed by name; refuses a core that
+    holds arrays this module does not know (a checkpoint must never miss state)."""
+    out = {}
+    for n in _field_names(solver):
+        try:
+            out[n] = solver.view(n)
+        except ValueError:
+            pass                                  # optional array not allocated in this scene
+    nreal = solver.getResumeState()["realFields"]
+    if len(out) != nreal:
+        raise CheckpointError(f"the core holds {nreal} particle arrays but the checkpoint knows {len(out)} "
+                              f"({', '.join(out)}); update yade_mpm.checkpoint._field_names")
+    out["id"] = solver.view("id")
+    return out
+
+
+def _material_dict(m):
+    return {a: getattr(m, a) for a in dir(m) if not a.startswith("_") and not callable(getattr(m, a))}
+
+
+def _digest(*arrays):
+    h = hashlib.sha256()
+    for a in arrays:
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
+
+
+def solver_fingerprint(solver):
+    """What makes a solver's scene this scene and not another: dimension, grid, particle count, the
+    particles' masses, initial volumes and surface loads (in id order), the material. These never
+    change while stepping, so a freshly built scene and a checkpoint of it mid-run agree on them."""
+    arrs = _particle_arrays(solver)
+    order = np.argsort(arrs["id"], kind="stable")
+    loads = [arrs[f"trac{a}"][order] for a in range(dim_of(solver)) if f"trac{a}" in arrs]
+    kind = solver.materialKind
+    mat = solver.dpgkParameters() if kind == 1 else solver.elasticParameters()
+    return {"dim": dim_of(solver), "origin": list(solver.origin), "spacing": solver.spacing,
+            "cells": list(solver.cells), "particles": int(solver.numParticles),
+            "arrays": sorted(k for k in arrs if k != "id"),
+            "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
+            "loads": _digest(*loads) if loads else None, "materialKind": int(kind),
+            "material": _material_dict(mat)}
+
+
+def _solver_state(solver):
+    arrs = {k: np.array(v, copy=True) for k, v in _particle_arrays(solver).items()}
+    rs = solver.getResumeState()
+    arrs["blockStart"] = np.array(rs["blockStart"], copy=True)
+    arrs["scalars"] = np.array([float(rs[k]) for k in _STATE_SCALARS], dtype=np.float64)
+    arrs["settings"] = np.array([float(getattr(solver, k)) for k in _SETTINGS], dtype=np.float64)
+    arrs["gravity"] = np.array(solver.gravity, dtype=np.float64)
+    return arrs
+
+
+def _restore_solver(solver, arrs):
+    sc = dict(zip(_STATE_SCALARS, arrs["scalars"].tolist()))
+    for k in ("steps",):
+        sc[k] = int(sc[k])
+    for k in ("needSort", "needCheck"):
+        sc[k] = bool(sc[k])
+    sc["blockStart"] = arrs["blockStart"]
+    views = _particle_arrays(solver)
+    for k in views:                               # shapes were checked before anything was changed
+        if views[k].shape != arrs[k].shape:
+            raise CheckpointError(f"particle array {k}: shape {arrs[k].shape} in the checkpoint, {views[k].shape} here")
+    old = {k: getattr(solver, k) for k in _SETTINGS}
+    old_g = solver.gravity
+    try:                                          # settings first: all or none
+        for k, v in zip(_SETTINGS, arrs["settings"].tolist()):
+            if v != float(old[k]):
+                setattr(solver, k, type(old[k])(v))
+        solver.gravity = tuple(arrs["gravity"].tolist())
+        solver.setResumeState(sc)                 # checks the block schedule before changing anything
+    except ValueError as e:
+        for k, v in old.items():
+            if getattr(solver, k) != v:
+                setattr(solver, k, v)
+        solver.gravity = old_g
+        raise CheckpointError(f"checkpoint: {e}") from None
+    for k, v in views.items():
+        np.copyto(v, arrs[k])
+
+
+# -------------------------------------------------------------------------------------- YADE state
+def _yade_O():
+    if "yade" not in sys.modules:
+        return None
+    from yade import O
+    return O
+
+
+def _body_state(O):
+    """Body states as float64 arrays (to check bitwise after O.load)."""
+    rows = []
+    for b in O.bodies:
+        if b is None:
+            rows.append([np.nan] * 16)
+            continue
+        s = b.state
+        q = s.ori
+        rows.append(list(s.pos) + list(s.vel) + list(s.angVel) + [q[0], q[1], q[2], q[3]] + list(s.refPos))
+    return np.array(rows, dtype=np.float64).reshape(-1, 16)
+
+
+def yade_fingerprint(O):
+    """Bodies (count, shape and material classes, dynamic or not) and engines (classes and labels)."""
+    bodies = [None if b is None else [type(b.shape).__name__, type(b.material).__name__, bool(b.dynamic)]
+              for b in O.bodies]
+    engines = [[type(e).__name__, e.label] for e in O.engines]
+    return {"bodies": bodies, "engines": engines}
+
+
+def _yade_blob(O, tmpdir):
+    tmp = os.path.join(tmpdir, f".yade-scene-{os.getpid()}.yade")   # binary archive: doubles bitwise
+    O.save(tmp)
+    try:
+        with open(tmp, "rb") as f:
+            return np.frombuffer(f.read(), dtype=np.uint8).copy()
+    finally:
+        os.remove(tmp)
+
+
+# -------------------------------------------------------------------------------------------- save
+def _engines_in_scene(O):
+    labels = {e.label for e in O.engines} if O is not None else set()
+    return {lab: e for lab, e in _engines.items() if lab in labels}
+
+
+def _resolve_solvers(solvers, O):
+    if solvers is None:
+        engines = _engines_in_scene(O)
+        if not engines:
+            raise ValueError("solvers: no MpmEngine is in O.engines; pass solvers=solver or {name: solver}")
+        return {lab: e.solver for lab, e in engines.items()}
+    if isinstance(solvers, (_core.Solver2D, _core.Solver3D)):
+        eng = [lab for lab, e in _engines_in_scene(O).items() if e.solver is solvers]
+        return {eng[0] if eng else "solver": solvers}
+    if isinstance(solvers, dict) and solvers and all(isinstance(v, (_core.Solver2D, _core.Solver3D)) for v in solvers.values()):
+        return dict(solvers)
+    raise ValueError("solvers must be None (the MpmEngines in O.engines), a Solver2D/3D or a non-empty {name: solver} dict")
+
+
+def save(path, solvers=None, yade=None, meta=None):
+    """Write a checkpoint of the whole simulation to `path` (atomically: a crash while writing leaves
+    the previous file intact). solvers: None = the solvers of the MpmEngines in O.engines, or a solver,
+    or {name: solver}; yade: include the YADE scene (None = when yade is imported and O has bodies or
+    engines); meta: a JSON-able dict stored alongside (e.g. the case and grid spacing; ``load`` with
+    the same meta refuses a checkpoint with another one). Call between steps (not from inside a
+    PyRunner). Returns the number of bytes written."""
+    O = _yade_O()
+    with_yade = (O is not None and (len(O.bodies) > 0 or len(O.engines) > 0)) if yade is None else bool(yade)
+    if with_yade and O is None:
+        raise ValueError("yade=True but yade is not imported")
+    sol = _resolve_solvers(solvers, O if with_yade else None)
+    if meta is not None:
+        json.dumps(meta)                           # must be JSON-able: fail before writing anything
+    arrays, header = {}, {"format": FORMAT, "build": build_id(), "written": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+                          "meta": meta, "solvers": {}, "yade": None}
+    for name, s in sol.items():
+        header["solvers"][name] = solver_fingerprint(s)
+        for k, v in _solver_state(s).items():
+            arrays[f"solver/{name}/{k}"] = v
+    if with_yade:
+        d = os.path.dirname(os.path.abspath(path))
+        os.makedirs(d, exist_ok=True)
+        arrays["yade/scene"] = _yade_blob(O, d)
+        arrays["yade/bodies"] = _body_state(O)
+        arrays["yade/clock"] = np.array([O.time, float(O.iter), O.dt], dtype=np.float64)
+        engines = _engines_in_scene(O)
+        header["yade"] = dict(yade_fingerprint(O), mpm_engines={lab: dict(e.checkpoint_state(), solver=_name_of(e.solver, sol))
+                                                                 for lab, e in engines.items()})
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    payload = buf.getvalue()
+    header["payload_bytes"] = len(payload)
+    header["payload_sha256"] = hashlib.sha256(payload).hexdigest()
+    hb = json.dumps(header).encode()
+    tmp = f"{path}.tmp-{os.getpid()}"
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(tmp, "wb") as f:
+        f.write(MAGIC + struct.pack("<Q", len(hb)) + hb + payload)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+    return len(MAGIC) + 8 + len(hb) + len(payload)
+
+
+def _name_of(solver, sol):
+    for k, v in sol.items():
+        if v is solver:
+            return k
+    return None
+
+
+# -------------------------------------------------------------------------------------------- load
+def read(path):
+    """(header, arrays) of a checkpoint file after checking magic, format, build, length and checksum;
+    raises CheckpointError naming the problem."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        raise CheckpointError(f"checkpoint {path}: cannot read ({e.strerror})") from None
+    if not raw.startswith(MAGIC):
+        raise CheckpointError(f"checkpoint {path}: not a yade-mpm checkpoint (bad magic)")
+    p = len(MAGIC)
+    if len(raw) < p + 8:
+        raise CheckpointError(f"checkpoint {path}: truncated ({len(raw)} bytes, header missing)")
+    (hl,) = struct.unpack("<Q", raw[p:p + 8])
+    if len(raw) < p + 8 + hl:
+        raise CheckpointError(f"checkpoint {path}: truncated ({len(raw)} bytes, header incomplete)")
+    try:
+        header = json.loads(raw[p + 8:p + 8 + hl])
+    except ValueError:
+        raise CheckpointError(f"checkpoint {path}: corrupted header") from None
+    if header.get("format") != FORMAT:
+        raise CheckpointError(f"checkpoint {path}: format version {header.get('format')}, this yade_mpm reads version {FORMAT}")
+    if header.get("build") != build_id():
+        raise CheckpointError(f"checkpoint {path}: written by another build of the yade_mpm core ({header.get('build')}, "
+                              f"this one is {build_id()}); a bitwise resume needs the same build — rerun from the start "
+                              "or rebuild the version that wrote it")
+    payload = raw[p + 8 + hl:]
+    if len(payload) != header.get("payload_bytes"):
+        raise CheckpointError(f"checkpoint {path}: truncated or padded (payload {len(payload)} bytes, "
+                              f"expected {header.get('payload_bytes')})")
+    if hashlib.sha256(payload).hexdigest() != header.get("payload_sha256"):
+        raise CheckpointError(f"checkpoint {path}: corrupted (checksum mismatch)")
+    with np.load(io.BytesIO(payload), allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    return header, arrays
+
+
+def _diff(a, b, prefix=""):
+    """Human-readable differences between two fingerprints (saved a, here b)."""
+    out = []
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in sorted(set(a) | set(b)):
+            out += _diff(a.get(k), b.get(k), f"{prefix}{k}.")
+    elif a != b:
+        sa, sb = json.dumps(a), json.dumps(b)
+        cut = lambda s: s if len(s) < 120 else s[:117] + "..."
+        out.append(f"{prefix[:-1] or 'value'}: checkpoint {cut(sa)}, this scene {cut(sb)}")
+    return out
+
+
+def load(path, solvers=None, yade=None, meta=None):
+    """Restore a checkpoint into the freshly built scene. solvers: as for ``save`` (None = the
+    MpmEngines registered under the labels the checkpoint names, i.e. the ones the scene script just
+    created); yade: restore the YADE scene (None = if the checkpoint has one); meta: if given, must
+    equal the meta stored by ``save``. Everything is checked before anything changes; on mismatch a
+    CheckpointError lists the differences. Returns the header (meta, time written, fingerprints)."""
+    header, arrays = read(path)
+    if meta is not None and json.loads(json.dumps(meta)) != header.get("meta"):
+        raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(_diff(header.get("meta"), json.loads(json.dumps(meta)), "meta.")))
+    saved_yade = header.get("yade")
+    with_yade = saved_yade is not None if yade is None else bool(yade)
+    if with_yade and saved_yade is None:
+        raise CheckpointError(f"checkpoint {path} holds no YADE scene (yade=True asked)")
+    O = _yade_O() if with_yade else None
+    if with_yade and O is None:
+        import yade  # noqa: F401  (the checkpoint has a YADE scene: load it)
+        O = _yade_O()
+    # which solver receives which saved state
+    names = list(header["solvers"])
+    if solvers is None:
+        sol = {}
+        for n in names:
+            lab = next((lab for lab, st in (saved_yade or {}).get("mpm_engines", {}).items() if st.get("solver") == n), n)
+            if lab not in _engines:
+                raise CheckpointError(f"checkpoint {path}: solver '{n}' belongs to MpmEngine '{lab}', which this scene has not "
+                                      f"created; build the scene first (MpmEngine(solver, label='{lab}')) or pass solvers=")
+            sol[n] = _engines[lab].solver
+    elif isinstance(solvers, (_core.Solver2D, _core.Solver3D)):
+        if len(names) != 1:
+            raise CheckpointError(f"checkpoint {path} holds {len(names)} solvers ({', '.join(names)}); pass solvers={{name: solver}}")
+        sol = {names[0]: solvers}
+    elif isinstance(solvers, dict):
+        sol = dict(solvers)
+        if set(sol) != set(names):
+            raise CheckpointError(f"checkpoint {path} holds solvers {sorted(names)}, given {sorted(sol)}")
+    else:
+        raise ValueError("solvers must be None, a Solver2D/3D or a {name: solver} dict")
+    problems = []
+    for n, s in sol.items():
+        problems += _diff(header["solvers"][n], solver_fingerprint(s), f"solver {n}: ")
+    if with_yade:
+        here = yade_fingerprint(O)
+        if here["bodies"] or here["engines"]:     # a scene was built: it must be the saved one
+            problems += _diff({k: saved_yade[k] for k in ("bodies", "engines")}, here, "YADE ")
+    if problems:
+        raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(problems[:8])
+                              + (f" (+{len(problems) - 8} more)" if len(problems) > 8 else ""))
+    for n, s in sol.items():                      # every check passed: now change the state
+        _restore_solver(s, {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")})
+    if with_yade:
+        d = os.path.dirname(os.path.abspath(path))
+        tmp = os.path.join(d, f".yade-scene-{os.getpid()}.yade")
+        arrays["yade/scene"].tofile(tmp)
+        try:
+            O.load(tmp)
+        finally:
+            os.remove(tmp)
+        if not np.array_equal(_body_state(O), arrays["yade/bodies"], equal_nan=True):
+            raise CheckpointError(f"checkpoint {path}: YADE body states differ after O.load (YADE serialization is not bitwise)")
+        clock = arrays["yade/clock"]
+        if not (O.time == clock[0] and O.iter == int(clock[1]) and O.dt == clock[2]):
+            raise CheckpointError(f"checkpoint {path}: O.time/O.iter/O.dt differ after O.load")
+        for lab, st in saved_yade.get("mpm_engines", {}).items():   # the PyRunners name engines by label
+            s = sol[st["solver"]]
+            e = _engines.get(lab)
+            if e is None or e.solver is not s:
+                e = MpmEngine(s, label=lab)
+            e.restore_checkpoint_state(st)
+    return header
+
+
+# ------------------------------------------------------------------------------------- run loop side
+class Checkpointer:
+    """Periodic checkpoints and clean stops for a run loop.
+
+        ck = Checkpointer("out/run.ckpt", every_steps=20000, every_minutes=None)
+        with ck.signals():                     # SIGINT/SIGTERM: ck.stop_requested becomes True
+            while not done:
+                O.run(chunk, True)
+                ck.tick(steps)                 # saves when due
+                if ck.stop_requested:
+                    ck.save(); write_outputs(); break
+
+    every_steps: steps between checkpoints (None = not by steps); every_minutes: wall minutes
+    between checkpoints (None = not by time). save() passes `solvers`, `meta` to ``save``."""
+
+    def __init__(self, path, every_steps=None, every_minutes=None, solvers=None, meta=None, verbose=True):
+        if every_steps is not None and not (int(every_steps) == every_steps and every_steps >= 1):
+            raise ValueError(f"every_steps = {every_steps} must be an integer ≥ 1 (or None)")
+        if every_minutes is not None and not (np.isfinite(every_minutes) and every_minutes > 0):
+            raise ValueError(f"every_minutes = {every_minutes} must be > 0 (or None)")
+        self.path, self.every_steps, self.every_minutes = path, every_steps, every_minutes
+        self.solvers, self.meta, self.verbose = solvers, meta, verbose
+        self.last_step, self.last_wall = None, time.time()
+        self.stop_requested, self.signal_name = False, None
+        self.saved = 0
+
+    def due(self, step):
+        if self.last_step is None:
+            self.last_step = step
+        if self.every_steps is not None and step - self.last_step >= self.every_steps:
+            return True
+        return self.every_minutes is not None and time.time() - self.last_wall >= 60 * self.every_minutes
+
+    def tick(self, step):
+        """Save if a checkpoint is due at this step. Returns True if one was written."""
+        if self.due(step):
+            self.save(step)
+            return True
+        return False
+
+    def save(self, step=None):
+        nbytes = save(self.path, solvers=self.solvers, meta=self.meta)
+        self.last_step = step if step is not None else self.last_step
+        self.last_wall = time.time()
+        self.saved += 1
+        if self.verbose:
+            print(f"[checkpoint] {self.path} ({nbytes / 1e6:.1f} MB)" + (f" at step {step}" if step is not None else ""), flush=True)
+
+    def signals(self):
+        """Context manager: SIGINT and SIGTERM set `stop_requested` (the loop then saves and stops)
+        instead of killing the process; a second signal stops at once. Handlers restored on exit."""
+        ck = self
+
+        class _Guard:
+            def __enter__(self):
+                self.old = {}
+                for sig in (signal.SIGINT, signal.SIGTERM):
+                    try:
+                        self.old[sig] = signal.signal(sig, self.handler)
+                    except ValueError:            # not the main thread: no signal handling
+                        pass
+                return ck
+
+            def handler(self, signum, frame):
+                if ck.stop_requested:             # second signal: give up the clean stop
+                    raise KeyboardInterrupt
+                ck.stop_requested, ck.signal_name = True, signal.Signals(signum).name
+                print(f"\n[checkpoint] {ck.signal_name}: writing a last checkpoint and the outputs, then stopping "
+                      "(send it again to stop at once)", flush=True)
+
+            def __exit__(self, *exc):
+                for sig, h in self.old.items():
+                    signal.signal(sig, h)
+                return False
+
+        return _Guard()

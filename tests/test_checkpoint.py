@@ -1,0 +1,217 @@
+"""Checkpoint / resume (yade_mpm.checkpoint): a run stopped half-way, saved, rebuilt and resumed gives
+the particle arrays, body states and clock of the uninterrupted run bit for bit; truncated, corrupted,
+other-version and other-scene checkpoints are refused before anything changes; SIGINT during a run
+leaves a loadable checkpoint that resumes (in another process) onto the uninterrupted run."""
+import json
+import math
+import os
+import signal
+import struct
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import yade_mpm as ym
+from yade_mpm import checkpoint
+
+yade = pytest.importorskip("yade")
+
+SCENE = textwrap.dedent("""
+    import math
+    import yade_mpm as ym
+    from yade import O, utils
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+
+    def build(radius=0.03):
+        # DP–GK block with a hole, squeezed (plastic + damaged particles, re-sorts every 7 steps),
+        # plus a free YADE sphere under gravity: MPM state and body state both evolve.
+        O.reset()
+        mat = ym.DpGkMat(young=22.41e9, poisson=0.2313, density=2500, frictionAngle=math.radians(32.5),
+                         dilatancyAngle=math.radians(8.125), cohesion=24.8e6, critPlasticStrain=0.1,
+                         weibullK=1.1798e29, weibullM=7.5)
+        s = ym.make_solver((0, 0), (0.3, 0.15), 0.01, margin=1)
+        ym.add_region(s, mat, (0, 0), (0.3, 0.15), holes=[ym.Circle((0.15, 0.07), radius)])
+        s.gravity = (0, -9.81)
+        s.addBoundaryPlane(1, -1, 0.0, "fixed")
+        s.damping, s.sortPeriod = 0.05, 7
+        s.view("v0")[:] = 40 * (s.view("x0") - 0.15)
+        s.view("v1")[:] = -40 * s.view("x1")
+        s.requestSort()
+        O.bodies.append(utils.sphere((1, 1, 0), 0.1))
+        O.bodies[0].state.vel = (0.3, 1.1, 0)
+        O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmCk").runner(), NewtonIntegrator(gravity=(0, -9.81, 0))]
+        O.dt = 1.0
+        return s
+""")
+exec(SCENE)   # defines build() here; the subprocess below runs the same text
+
+
+def _state(s):
+    from yade import O
+    arrays = {k: np.array(v) for k, v in ym.views(s).items()}      # storage order: the order is state too
+    b = O.bodies[0].state
+    return arrays, (tuple(b.pos), tuple(b.vel), tuple(b.angVel), tuple(b.ori)), (O.time, O.iter, O.dt, s.time, s.steps)
+
+
+def _assert_same(a, b):
+    assert a[0].keys() == b[0].keys()
+    for k in a[0]:
+        np.testing.assert_array_equal(a[0][k], b[0][k], err_msg=k)
+    assert a[1] == b[1] and a[2] == b[2]
+
+
+def test_resume_is_bitwise(tmp_path):
+    from yade import O
+    N = 40
+    s = build()
+    O.run(N, True)
+    ref = _state(s)
+    assert np.count_nonzero(s.view("damage")) > 0 and np.count_nonzero(s.view("epsP")) > 0   # a loaded scene
+    s = build()
+    O.run(N // 2 + 1, True)                        # an odd split: the sort phase (steps % 7) is mid-period
+    checkpoint.save(tmp_path / "c.ckpt")
+    O.run(3, True)                                 # the scene moves on after saving
+    s = build()                                    # as a new process would: rebuild, then load
+    checkpoint.load(tmp_path / "c.ckpt")
+    assert s.steps == O.iter == N // 2 + 1
+    O.run(N - N // 2 - 1, True)
+    _assert_same(ref, _state(s))
+    assert ym.engine("mpmCk").solver is s
+
+
+def test_solver_only_resume_is_bitwise(tmp_path):
+    def make():
+        s = ym.make_solver((0, 0), (0.2, 0.1), 0.01)
+        ym.add_region(s, ym.ElasticMat(young=1e9, poisson=0.25, density=2000), (0, 0), (0.2, 0.1))
+        s.addBoundaryPlane(1, -1, 0.0, "fixed")
+        s.gravity, s.sortPeriod = (0, -9.81), 5
+        s.view("v0")[:] = 3 * np.sin(20 * s.view("x1"))
+        s.requestSort()
+        return s
+    a = make()
+    a.run(30)
+    b = make()
+    b.run(13)
+    checkpoint.save(tmp_path / "s.ckpt", solvers=b, yade=False)
+    c = make()
+    checkpoint.load(tmp_path / "s.ckpt", solvers=c)
+    c.run(17)
+    for k, v in ym.views(a).items():
+        np.testing.assert_array_equal(v, ym.views(c)[k], err_msg=k)
+    assert (a.time, a.steps, a.lastDt) == (c.time, c.steps, c.lastDt)
+
+
+def _rewrite(src, dst, edit_header=None, payload=lambda p: p, raw=lambda r: r):
+    data = open(src, "rb").read()
+    p = len(checkpoint.MAGIC)
+    (hl,) = struct.unpack("<Q", data[p:p + 8])
+    header = json.loads(data[p + 8:p + 8 + hl])
+    body = payload(data[p + 8 + hl:])
+    if edit_header:
+        edit_header(header)
+    hb = json.dumps(header).encode()
+    open(dst, "wb").write(raw(checkpoint.MAGIC + struct.pack("<Q", len(hb)) + hb + body))
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory):
+    from yade import O
+    path = tmp_path_factory.mktemp("ck") / "good.ckpt"
+    build()
+    O.run(10, True)
+    checkpoint.save(path, meta={"case": "block", "spacing": 0.01})
+    return path
+
+
+@pytest.mark.parametrize("kind, message", [
+    ("truncated", "truncated"), ("flipped", "corrupted"), ("format", "format version"),
+    ("build", "another build"), ("not", "not a yade-mpm checkpoint"), ("header", "truncated")])
+def test_bad_checkpoint_is_refused_and_nothing_changes(saved, tmp_path, kind, message):
+    from yade import O
+    bad = tmp_path / "bad.ckpt"
+    if kind == "truncated":
+        _rewrite(saved, bad, raw=lambda r: r[:-1000])
+    elif kind == "flipped":
+        _rewrite(saved, bad, payload=lambda p: p[:500] + bytes([p[500] ^ 1]) + p[501:])
+    elif kind == "format":
+        _rewrite(saved, bad, edit_header=lambda h: h.update(format=checkpoint.FORMAT + 1))
+    elif kind == "build":
+        _rewrite(saved, bad, edit_header=lambda h: h.update(build="0123456789abcdef"))
+    elif kind == "not":
+        bad.write_bytes(b"PK\x03\x04 some zip file")
+    else:
+        bad.write_bytes(open(saved, "rb").read()[:len(checkpoint.MAGIC) + 20])
+    s = build()
+    before = _state(s)
+    with pytest.raises(checkpoint.CheckpointError, match=message):
+        checkpoint.load(bad)
+    _assert_same(before, _state(s))                 # never half-loaded
+
+
+def test_other_scene_is_refused(saved):
+    s = build(radius=0.04)                          # another hole: other particles
+    before = _state(s)
+    with pytest.raises(checkpoint.CheckpointError, match=r"another scene: solver .*particles"):
+        checkpoint.load(saved)
+    _assert_same(before, _state(s))
+    build()
+    with pytest.raises(checkpoint.CheckpointError, match=r"another scene: meta.case"):
+        checkpoint.load(saved, meta={"case": "tunnel", "spacing": 0.01})
+    from yade import O, utils
+    O.bodies.append(utils.sphere((2, 1, 0), 0.1))   # same MPM scene, another YADE scene
+    with pytest.raises(checkpoint.CheckpointError, match="YADE bodies"):
+        checkpoint.load(saved)
+
+
+CHILD = SCENE + textwrap.dedent("""
+    import sys
+    from yade_mpm import checkpoint
+    path, out = sys.argv[1], sys.argv[2]
+    s = build()
+    ck = checkpoint.Checkpointer(path)
+    with ck.signals():
+        for chunk in range(100000):
+            O.run(5, True)
+            if chunk == 2:
+                print("running", flush=True)
+            if ck.stop_requested:
+                ck.save(O.iter)
+                open(out, "w").write(f"{O.iter}\\n")        # the outputs so far
+                break
+    print("stopped cleanly at", O.iter, flush=True)
+""")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_signal_leaves_a_checkpoint_that_resumes_bitwise(tmp_path, sig):
+    from yade import O
+    script = tmp_path / "child.py"
+    script.write_text(CHILD)
+    ckpt, out = tmp_path / "run.ckpt", tmp_path / "out.txt"
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.pathsep.join(sys.path))
+    p = subprocess.Popen([sys.executable, str(script), str(ckpt), str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, env=env)
+    for line in p.stdout:
+        if line.startswith("running"):
+            break
+    p.send_signal(sig)
+    rest, err = p.communicate(timeout=120)
+    assert p.returncode == 0, err
+    assert "stopped cleanly" in rest
+    k = int(out.read_text())
+    assert k >= 15 and k % 5 == 0
+    n = ym.getThreads()
+    ym.setThreads(1)                                # the child ran with one thread
+    try:
+        s = build()
+        checkpoint.load(ckpt)                       # written by another process
+        assert s.steps == O.iter == k
+        O.run(5, True)
+        resumed = _state(s)
+        s = build()
+        O.run(k + 5, True)
+        _assert_same(_state(s), resumed)
+    finally:
+        ym.setThreads(n)
