@@ -3,7 +3,6 @@ the particle arrays, body states and clock of the uninterrupted run bit for bit;
 other-version and other-scene checkpoints are refused before anything changes; SIGINT during a run
 leaves a loadable checkpoint that resumes (in another process) onto the uninterrupted run."""
 import json
-import math
 import os
 import signal
 import struct
@@ -19,7 +18,6 @@ from yade_mpm import checkpoint
 yade = pytest.importorskip("yade")
 
 SCENE = textwrap.dedent("""
-    import math
     import yade_mpm as ym
     from yade import O, utils
     from yade.wrapper import ForceResetter, NewtonIntegrator
@@ -28,9 +26,7 @@ SCENE = textwrap.dedent("""
         # DP–GK block with a hole, squeezed (plastic + damaged particles, re-sorts every 7 steps),
         # plus a free YADE sphere under gravity: MPM state and body state both evolve.
         O.reset()
-        mat = ym.DpGkMat(young=22.41e9, poisson=0.2313, density=2500, frictionAngle=math.radians(32.5),
-                         dilatancyAngle=math.radians(8.125), cohesion=24.8e6, critPlasticStrain=0.1,
-                         weibullK=1.1798e29, weibullM=7.5)
+        mat = ym.rocks.granite_dpgk()
         s = ym.make_solver((0, 0), (0.3, 0.15), 0.01, margin=1)
         ym.add_region(s, mat, (0, 0), (0.3, 0.15), holes=[ym.Circle((0.15, 0.07), radius)])
         s.gravity = (0, -9.81)
@@ -84,7 +80,7 @@ def test_resume_is_bitwise(tmp_path):
 def test_solver_only_resume_is_bitwise(tmp_path):
     def make():
         s = ym.make_solver((0, 0), (0.2, 0.1), 0.01)
-        ym.add_region(s, ym.ElasticMat(young=1e9, poisson=0.25, density=2000), (0, 0), (0.2, 0.1))
+        ym.add_region(s, ym.rocks.granite(), (0, 0), (0.2, 0.1))
         s.addBoundaryPlane(1, -1, 0.0, "fixed")
         s.gravity, s.sortPeriod = (0, -9.81), 5
         s.view("v0")[:] = 3 * np.sin(20 * s.view("x1"))
