@@ -65,6 +65,9 @@ def parse_args(argv=None):
     p.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all cores)")
     p.add_argument("--progress", type=float, default=10.0, help="wall seconds between progress lines")
     p.add_argument("--no-vtu", dest="vtu", action="store_false", help="skip the VTU particle file")
+    p.add_argument("--vtu-every", type=float, default=0.0,
+                   help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "
+                        "many simulated seconds [s] (default 0: final state only)")
     a = p.parse_args(argv)
     check_args(a)
     return a
@@ -91,6 +94,8 @@ def check_args(a):
         raise ValueError(f"--max-time = {a.max_time} s must be > 0")
     if a.threads < 0:
         raise ValueError(f"--threads = {a.threads} must be ≥ 0 (0 = all cores)")
+    if not (math.isfinite(a.vtu_every) and a.vtu_every >= 0):
+        raise ValueError(f"--vtu-every = {a.vtu_every} s must be ≥ 0 (0 = no series)")
     if a.progress <= 0:
         raise ValueError(f"--progress = {a.progress} s must be > 0")
 
@@ -131,8 +136,9 @@ class LineSamples:
         return np.concatenate([np.concatenate(v) for v in self.stresses(s).values()])
 
 
-def relax(s, samples, args, spacing, label):
-    """Run to the quasi-static state; returns (converged, check history)."""
+def relax(s, samples, args, spacing, label, series=None):
+    """Run to the quasi-static state; returns (converged, check history). series: an output.VtuSeries
+    written every --vtu-every seconds, at the start and at the end."""
     cp = rocks.granite().pWaveSpeed()
     transit = args.domain / cp
     max_time = args.max_time or 40 * transit
@@ -150,8 +156,10 @@ def relax(s, samples, args, spacing, label):
             converged[0] = True
             return runner.STOP
 
-    runner.run(s, end_time=max_time, progress=args.progress, label=label,
-               outputs=[runner.Output(check, period=check_dt, at_end=True)])
+    outputs = [runner.Output(check, period=check_dt, at_end=True)]
+    if series is not None:
+        outputs.append(runner.Output(series.write, period=args.vtu_every, at_start=True, at_end=True))
+    runner.run(s, end_time=max_time, progress=args.progress, label=label, outputs=outputs)
     return converged[0], history
 
 
@@ -218,11 +226,11 @@ def evaluate(s, samples, spacing, ppc, domain):
     return res, prof
 
 
-def run_case(spacing, args, label):
+def run_case(spacing, args, label, series=None):
     t0 = time.time()
     s, _, _ = cases.circular_opening(spacing, args.domain, args.ppc, args.damping, args.boundary_load)
     samples = LineSamples(s, spacing, args.ppc)
-    converged, hist = relax(s, samples, args, spacing, label)
+    converged, hist = relax(s, samples, args, spacing, label, series)
     wall = time.time() - t0
     res, prof = evaluate(s, samples, spacing, args.ppc, args.domain)
     res.update(grid_spacing_m=spacing, particles=int(s.numParticles), steps=int(s.steps), simulated_time_s=float(s.time),
@@ -313,7 +321,8 @@ def main(argv=None):
                           reverse=True)
     table, main_res = [], None
     for l in spacings:
-        s, res, prof, hist = run_case(l, args, f"opening l={l}")
+        series = out.VtuSeries(os.path.join(args.out, "series")) if (args.vtu_every > 0 and l == args.spacing) else None
+        s, res, prof, hist = run_case(l, args, f"opening l={l}", series)
         table.append(res)
         if l == args.spacing:
             main_res, main_prof, main_hist, main_s = res, prof, hist, s

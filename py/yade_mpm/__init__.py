@@ -18,7 +18,7 @@ from .scene import (make_solver, add_region, views, get, id_order, set_initial_s
 from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
 from .progress import Progress
-from . import rocks, cases, runner  # noqa: E402  (named rock sets, scene builders, the run loop)
+from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene builders, run loop, result files)
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
