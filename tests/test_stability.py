@@ -1,16 +1,12 @@
-"""Stability suite, fast versions (coarse grids) of scripts/stability.py: every case finishes, or is
+"""Stability suite (yade_mpm.stability), fast versions (coarse grids) of scripts/stability.py: every case finishes, or is
 stopped by the solver with a message naming step, particle id and quantity; no NaN; KE + U_el never
 above the input energy by more than the tolerance; Δt never above the stable limit."""
 import math
-import os
-import sys
 
 import numpy as np
 import pytest
 import yade_mpm as ym
-
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts"))
-import stability as st  # noqa: E402
+from yade_mpm import stability as st
 
 
 @pytest.fixture(scope="module", autouse=True)
