@@ -40,7 +40,8 @@ struct ParamInfo {
 	{
 		if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
 		char b[32];
-		snprintf(b, sizeof(b), "%g", x);
+		if (x == std::floor(x) && std::abs(x) < 1e15 && std::abs(x) >= 1e6) snprintf(b, sizeof(b), "%.0f", x); // counts: 16777216, not 1.67772e+07
+		else snprintf(b, sizeof(b), "%g", x);
 		return b;
 	}
 	// "(0, inf)", "[0, 1]", ...

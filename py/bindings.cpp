@@ -5,6 +5,7 @@
 #include "param_binding.hpp"
 #include <boost/python.hpp>
 #include <boost/python/numpy.hpp>
+#include <unistd.h>
 
 namespace bp = boost::python;
 namespace np = boost::python::numpy;
@@ -18,13 +19,14 @@ void translateInput(const InputError& e) { PyErr_SetString(PyExc_ValueError, e.w
 void translateSimulation(const SimulationError& e) { PyErr_SetString(simulationErrorType, e.what()); }
 
 template <int D>
-typename Dim<D>::Vec toVec(const bp::object& o, const char* name)
+typename Dim<D>::Vec toVec(const bp::object& o, const std::string& name, const char* unit = "m")
 {
-	if (bp::len(o) != D) throw InputError(std::string(name) + " must have " + std::to_string(D) + " components");
+	auto                 c = argReals(o, name, D, unit);
 	typename Dim<D>::Vec v;
-	for (int a = 0; a < D; ++a) v[a] = bp::extract<double>(o[a]);
+	for (int a = 0; a < D; ++a) v[a] = c[a];
 	return v;
 }
+inline std::string solverName(int D) { return D == 2 ? "Solver2D" : "Solver3D"; }
 template <int D>
 bp::tuple fromVec(const typename Dim<D>::Vec& v)
 {
@@ -48,13 +50,43 @@ template <int D>
 struct SolverWrap {
 	using S = Solver<D>;
 
-	static std::shared_ptr<S> make(bp::object origin, double spacing, bp::object cells)
+	static std::string who(const char* what) { return solverName(D) + ": " + what; }
+
+	static std::shared_ptr<S> make(bp::object origin, bp::object spacing, bp::object cells)
 	{
+		const auto o = toVec<D>(origin, who("origin"));
+		const Real h = argReal(spacing, who("spacing"), "m", 0, INFINITY, OO);
+		PyObject*  q = cells.ptr();
+		if (!(PySequence_Check(q) && !PyUnicode_Check(q) && PySequence_Size(q) == D)) {
+			PyErr_Clear();
+			throw InputError(who("cells") + " must be a sequence of " + std::to_string(D) + " integers ≥ 1 (got " + pyTypeName(q) + " " + pyRepr(cells) + ")");
+		}
 		typename Dim<D>::IVec n;
-		if (bp::len(cells) != D) throw InputError("cells must have " + std::to_string(D) + " components");
-		for (int a = 0; a < D; ++a) n[a] = bp::extract<int>(cells[a]);
-		return std::make_shared<S>(toVec<D>(origin, "origin"), spacing, n);
+		double nodes = 1;
+		for (int a = 0; a < D; ++a) {
+			n[a] = int(argInt(cells[a], who("cells") + "[" + std::to_string(a) + "]", 1, 1 << 24));
+			if (!std::isfinite(o[a] + n[a] * h))
+				throw InputError(who("origin") + " + cells·spacing along axis " + std::to_string(a) + " is not a finite coordinate (origin "
+				                 + ParamInfo::num(o[a]) + " m, spacing " + ParamInfo::num(h) + " m)");
+			nodes *= n[a] + 1 + 2 * Grid<D>::ghost;
+		}
+		// Refuse a grid the machine cannot hold, with the numbers (was an empty MemoryError).
+		const double bytes = nodes * (sizeof(Node<D>) + 2), phys = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+		if (bytes > phys)
+			throw InputError(who("cells") + ": a grid of " + ParamInfo::num(nodes) + " nodes needs " + ParamInfo::num(bytes / 1e9) + " GB, more than this machine's "
+			                 + ParamInfo::num(phys / 1e9) + " GB of memory; use fewer cells or a larger spacing");
+		return std::make_shared<S>(o, h, n);
 	}
+	static void setMaterial(S& s, bp::object m)
+	{
+		bp::extract<const DpGkMat&> dp(m);
+		if (dp.check()) return s.setMaterial(dp());
+		bp::extract<const ElasticMat&> el(m);
+		if (el.check()) return s.setMaterial(el());
+		throw InputError(who("setMaterial: material") + " must be an ElasticMat or a DpGkMat (got " + pyTypeName(m.ptr()) + ")");
+	}
+	static void advance(S& s, bp::object dt) { s.advance(argReal(dt, who("advance: dt"), "s", 0, INFINITY, OO)); }
+	static Real loadScale(S& s, bp::object t) { return s.loadScale(argReal(t, who("loadScale: t"), "s")); }
 	static void addParticles(S& s, bp::object pos, bp::object vol, bp::object mass)
 	{
 		np::ndarray x = asDoubleArray(pos, "positions", D);
@@ -78,8 +110,12 @@ struct SolverWrap {
 			s.setParticleForce(size_t(ip[k]), fv);
 		}
 	}
-	static void addPlane(S& s, int axis, int side, double pos, const std::string& kind)
+	static void addPlane(S& s, bp::object axisO, bp::object sideO, bp::object posO, bp::object kindO)
 	{
+		const int         axis = int(argInt(axisO, who("addBoundaryPlane: axis"), 0, D - 1));
+		const int         side = int(argInt(sideO, who("addBoundaryPlane: side (-1 lower, +1 upper)"), -1, 1));
+		const Real        pos  = argReal(posO, who("addBoundaryPlane: position"), "m");
+		const std::string kind = argStr(kindO, who("addBoundaryPlane: kind ('fixed' or 'slip')"));
 		BoundaryKind k;
 		if (kind == "fixed") k = BoundaryKind::Fixed;
 		else if (kind == "slip") k = BoundaryKind::Slip;
@@ -88,8 +124,9 @@ struct SolverWrap {
 	}
 
 	// NumPy view on one particle array. The owner reference keeps the solver alive.
-	static np::ndarray view(bp::object self, const std::string& name)
+	static np::ndarray view(bp::object self, bp::object nameO)
 	{
+		const std::string name = argStr(nameO, who("view: name"));
 		S&                 s = bp::extract<S&>(self);
 		auto&              P = s.P;
 		std::vector<Real>* f = nullptr;
@@ -137,7 +174,7 @@ struct SolverWrap {
 	// ψ_i and ∇ψ_i at a point: (node indices, ψ, ∇ψ) over the 4^D stencil; for tests and inspection.
 	static bp::tuple shapeFunctions(S& s, bp::object point)
 	{
-		auto       x = toVec<D>(point, "point");
+		auto       x = toVec<D>(point, who("shapeFunctions: point"));
 		Stencil<D> st;
 		StencilOffsets<D> so(s.grid);
 		Real xa[D];
@@ -193,10 +230,10 @@ struct SolverWrap {
 		return d;
 	}
 	static void resetPhaseTimes(S& s) { s.phase = PhaseTimes {}; }
-	static void run(S& s, long n)
+	static void run(S& s, bp::object steps)
 	{
-		if (n < 0) throw InputError("number of steps must be ≥ 0");
-		for (long k = 0; k < n; ++k) s.step();
+		const long long n = argInt(steps, who("run: steps"), 0, 9.2e18);
+		for (long long k = 0; k < n; ++k) s.step();
 	}
 	static bp::tuple getGravity(S& s) { return fromVec<D>(s.gravity); }
 	static void setGravity(S& s, bp::object g)
@@ -253,7 +290,10 @@ struct SolverWrap {
 		auto* p = reinterpret_cast<uint32_t*>(a.get_data());
 		s.setResumeState(r, std::vector<uint32_t>(p, p + a.shape(0)));
 	}
-	static void setNodeExcluded(S& s, size_t i, bool ex) { s.grid.setExcluded(i, ex); }
+	static void setNodeExcluded(S& s, bp::object i, bp::object ex)
+	{
+		s.grid.setExcluded(size_t(argInt(i, who("setNodeExcluded: node"), 0, double(s.grid.size() - 1))), argBool(ex, who("setNodeExcluded: excluded")));
+	}
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
 	// Settings are routed through one validating setter so every bad value raises ValueError.
@@ -271,12 +311,11 @@ struct SolverWrap {
 		bp::class_<S, std::shared_ptr<S>, boost::noncopyable>(name, "Explicit WLS-MPM solver (MUSL) on a fixed regular grid.", bp::no_init)
 		        .def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"))))
 		        .def("addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses")))
-		        .def("setMaterial", static_cast<void (S::*)(const ElasticMat&)>(&S::setMaterial))
-		        .def("setMaterial", static_cast<void (S::*)(const DpGkMat&)>(&S::setMaterial))
+		        .def("setMaterial", &setMaterial, bp::arg("material"))
 		        .def("addBoundaryPlane", &addPlane, (bp::arg("axis"), bp::arg("side"), bp::arg("position"), bp::arg("kind")))
 		        .def("setParticleForces", &setForces, (bp::arg("indices"), bp::arg("forces")))
 		        .def("step", static_cast<void (S::*)()>(&S::step))
-		        .def("advance", &S::advance, bp::arg("dt"))
+		        .def("advance", &advance, bp::arg("dt"))
 		        .def("run", &run, bp::arg("steps"))
 		        .def("stableDt", &S::stableDt)
 		        .def("waveSpeed", &S::waveSpeed)
@@ -296,7 +335,7 @@ struct SolverWrap {
 		        .def("setResumeState", &setResumeState, bp::arg("state"))
 		        .def("elasticParameters", &S::elasticParameters, bp::return_value_policy<bp::copy_const_reference>())
 		        .def("dpgkParameters", &S::dpgkParameters, bp::return_value_policy<bp::copy_const_reference>())
-		        .def("loadScale", &S::loadScale)
+		        .def("loadScale", &loadScale, bp::arg("t"))
 		        .add_property("numParticles", &numParticles)
 		        .add_property("bytesPerParticle", &bytesPerParticle)
 		        .add_property("materialKind", &materialKind)
@@ -322,17 +361,23 @@ struct SolverWrap {
 
 // Single material point DP–GK update, for tests and for checking the return map by hand.
 template <int D>
-bp::tuple dpgkPointUpdate(const DpGkMat& m, bp::object stress, bp::object strainInc, double epsP, double damage, double eps0, double dt)
+bp::tuple dpgkPointUpdate(bp::object matO, bp::object stress, bp::object strainInc, bp::object epsPO, bp::object damageO, bp::object eps0O, bp::object dtO)
 {
+	const std::string fn = "dpgkPointUpdate" + std::to_string(D) + "D: ";
+	bp::extract<const DpGkMat&> mx(matO);
+	if (!mx.check()) throw InputError(fn + "material must be a DpGkMat (got " + pyTypeName(matO.ptr()) + ")");
+	const DpGkMat& m = mx();
 	m.validate();
 	constexpr int NS = Dim<D>::nSym;
-	if (bp::len(stress) != NS || bp::len(strainInc) != NS) throw InputError("stress and strainInc need " + std::to_string(NS) + " components");
+	const auto    sv = argReals(stress, fn + "stress", NS, "Pa");
+	const auto    dv = argReals(strainInc, fn + "strainInc", NS, "-");
+	Real epsP   = argReal(epsPO, fn + "epsP (accumulated plastic strain)", "-", 0, INFINITY, CO);
+	Real damage = argReal(damageO, fn + "damage", "-", 0, 1, CC);
+	Real eps0   = argReal(eps0O, fn + "eps0 (damage threshold strain)", "-", 0, INFINITY, OO);
+	Real dt     = argReal(dtO, fn + "dt", "s", 0, INFINITY, CO);
 	DruckerPragerGradyKipp<D> mat(m);
 	Sym<D>                    s, de;
-	for (int k = 0; k < NS; ++k) {
-		s.c[k]  = bp::extract<double>(stress[k]);
-		de.c[k] = bp::extract<double>(strainInc[k]);
-	}
+	for (int k = 0; k < NS; ++k) s.c[k] = sv[k], de.c[k] = dv[k];
 	elasticTrial(s, de, mat.K, mat.G);
 	ReturnInfo r;
 	if (m.plasticity) r = mat.plasticReturn(s, epsP);
@@ -343,11 +388,10 @@ bp::tuple dpgkPointUpdate(const DpGkMat& m, bp::object stress, bp::object strain
 	return bp::make_tuple(ls, le, epsP, damage, r.mode, r.dLambda);
 }
 
-void setThreads(int n)
-{
-	if (n < 1) throw InputError("threads must be ≥ 1");
-	omp_set_num_threads(n);
-}
+// More threads than 4 per processor only add barrier overhead; far more crashed the process
+// (100000: a step segfaulted; 1000: libgomp aborted).
+int maxThreads() { return std::max(16, 4 * omp_get_num_procs()); }
+void setThreads(bp::object n) { omp_set_num_threads(int(argInt(n, "setThreads: threads", 1, maxThreads()))); }
 int getThreads() { return omp_get_max_threads(); }
 
 } // namespace
@@ -384,8 +428,10 @@ BOOST_PYTHON_MODULE(_core)
 
 	SolverWrap<2>::expose("Solver2D");
 	SolverWrap<3>::expose("Solver3D");
-	bp::def("dpgkPointUpdate2D", &dpgkPointUpdate<2>);
-	bp::def("dpgkPointUpdate3D", &dpgkPointUpdate<3>);
-	bp::def("setThreads", &setThreads);
+	const auto pointArgs = (bp::arg("material"), bp::arg("stress"), bp::arg("strainInc"), bp::arg("epsP"), bp::arg("damage"), bp::arg("eps0"), bp::arg("dt"));
+	const char* pointDoc  = "One DP–GK material-point update: (state stress, damaged stress, epsP, damage, mode 0/1/2 elastic/cone/apex, Δλ).";
+	bp::def("dpgkPointUpdate2D", &dpgkPointUpdate<2>, pointArgs, pointDoc);
+	bp::def("dpgkPointUpdate3D", &dpgkPointUpdate<3>, pointArgs, pointDoc);
+	bp::def("setThreads", &setThreads, bp::arg("threads"), "Number of OpenMP threads, in [1, max(16, 4 × processors)].");
 	bp::def("getThreads", &getThreads);
 }

@@ -220,3 +220,42 @@ struct ParamBinding {
 };
 
 } // namespace mpm
+
+namespace mpm {
+// Named conversion of one function argument (same checks and messages as the parameter setters):
+// who = "Solver2D.run: steps", range [lo, hi] with `ends` as in the tables.
+inline Real argReal(const bp::object& o, const std::string& who, const char* unit, Real lo = -INFINITY, Real hi = INFINITY, int ends = OO)
+{
+	const ParamInfo p { who.c_str(), "float", 0, unit, lo, hi, ends, "", "", "", "" };
+	return pyToParam<Real>(o, who, p);
+}
+inline long long argInt(const bp::object& o, const std::string& who, Real lo, Real hi)
+{
+	const ParamInfo p { who.c_str(), "int", 0, "-", lo, hi, CC, "", "", "", "" };
+	return pyToParam<long long>(o, who, p);
+}
+inline bool argBool(const bp::object& o, const std::string& who)
+{
+	const ParamInfo p { who.c_str(), "bool", 0, "-", 0, 1, CC, "", "", "", "" };
+	return pyToParam<bool>(o, who, p);
+}
+inline std::string argStr(const bp::object& o, const std::string& who)
+{
+	if (!PyUnicode_Check(o.ptr())) throw InputError(who + " must be a string (got " + pyTypeName(o.ptr()) + " " + pyRepr(o) + ")");
+	return bp::extract<std::string>(o);
+}
+// A sequence of exactly n numbers in range, as doubles.
+inline std::vector<Real> argReals(const bp::object& o, const std::string& who, int n, const char* unit, Real lo = -INFINITY, Real hi = INFINITY,
+                                  int ends = OO)
+{
+	PyObject*        q = o.ptr();
+	const Py_ssize_t len = PySequence_Check(q) && !PyUnicode_Check(q) ? PySequence_Size(q) : -1;
+	if (len != n) {
+		PyErr_Clear();
+		throw InputError(who + " must be a sequence of " + std::to_string(n) + " numbers [" + unit + "] (got " + pyTypeName(q) + " " + pyRepr(o) + ")");
+	}
+	std::vector<Real> v(n);
+	for (int k = 0; k < n; ++k) v[k] = argReal(o[k], who + "[" + std::to_string(k) + "]", unit, lo, hi, ends);
+	return v;
+}
+} // namespace mpm

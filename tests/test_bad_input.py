@@ -1,5 +1,9 @@
 """Bad input raises ValueError naming the parameter (and range) before any work is done."""
 import math
+import os
+import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -90,7 +94,7 @@ def test_nan_in_state_and_settings():
 def test_grid_parameters():
     with pytest.raises(ValueError, match="spacing"):
         ym.make_solver((0, 0), (1, 1), 0.0)
-    with pytest.raises(ValueError, match="grid spacing"):
+    with pytest.raises(ValueError, match=r"Solver2D: spacing = -1 \[m\] is outside the allowed range \(0, inf\)"):
         ym.Solver2D((0, 0), -1.0, (4, 4))
     with pytest.raises(ValueError, match="cells"):
         ym.Solver2D((0, 0), 1.0, (0, 4))
@@ -107,3 +111,64 @@ def test_position_corrupted_through_a_view_stops_cleanly():
     s.view("x1")[7] = np.nan
     with pytest.raises(ym.MpmSimulationError, match=f"step 1 .*particle id {victim} has a position outside the grid or not finite"):
         s.step()
+
+
+# ---- wrong types and values at the binding: a ValueError naming the argument and its range
+# (these were Boost ArgumentError/TypeError/OverflowError without the name, or silently accepted)
+def _dpgk():
+    return ym.rocks.granite_dpgk()
+
+
+def _upd(**kw):
+    a = dict(material=_dpgk(), stress=[0.0] * 4, strainInc=[1e-4, 0, 0, 0], epsP=0.0, damage=0.0, eps0=1e-4, dt=1e-6)
+    a.update(kw)
+    return ym.dpgkPointUpdate2D(*a.values())
+
+
+@pytest.mark.parametrize("call, msg", [
+    (lambda: ym.Solver2D((0, 0), "a", (4, 4)), r"Solver2D: spacing must be a number \[m\] in \(0, inf\) \(got str"),
+    (lambda: ym.Solver2D((0, 0), 0.1, (4, "a")), r"Solver2D: cells\[1\] must be an integer in \[1, 16777216\]"),
+    (lambda: ym.Solver2D((0, 0), 0.1, (4.5, 4)), r"cells\[0\] must be an integer"),
+    (lambda: ym.Solver2D((0, 0), 0.1, (10 ** 12, 4)), r"cells\[0\] = 1000000000000 .*outside the allowed range \[1, 16777216\]"),
+    (lambda: ym.Solver2D((0, 0), 0.1, (100000, 100000)), r"cells: a grid of .* nodes needs .* GB, more than this machine's"),
+    (lambda: ym.Solver2D(None, 0.1, (4, 4)), r"Solver2D: origin must be a sequence of 2 numbers \[m\]"),
+    (lambda: ym.Solver3D((0, 0, math.nan), 0.1, (4, 4, 4)), r"Solver3D: origin\[2\] = nan \[m\] is outside"),
+    (lambda: _solver().run("a"), r"run: steps must be an integer in \[0, "),
+    (lambda: _solver().run(10 ** 20), r"run: steps = 100000000000000000000 is outside"),
+    (lambda: _solver().advance("a"), r"advance: dt must be a number \[s\] in \(0, inf\)"),
+    (lambda: _solver().view(5), r"view: name must be a string \(got int"),
+    (lambda: _solver().addBoundaryPlane("a", 1, 0.0, "fixed"), r"addBoundaryPlane: axis must be an integer in \[0, 1\]"),
+    (lambda: _solver().addBoundaryPlane(0, 1, math.nan, "fixed"), r"addBoundaryPlane: position = nan \[m\]"),
+    (lambda: _solver().setNodeExcluded(-1, True), r"setNodeExcluded: node = -1 .*outside the allowed range \[0, "),
+    (lambda: _solver().setNodeExcluded(30, "yes"), r"setNodeExcluded: excluded must be True or False"),
+    (lambda: _solver().shapeFunctions("ab"), r"shapeFunctions: point must be a sequence of 2 numbers"),
+    (lambda: _solver().setMaterial(None), r"setMaterial: material must be an ElasticMat or a DpGkMat \(got NoneType\)"),
+    (lambda: ym.setThreads(2.5), r"setThreads: threads must be an integer in \[1, \d+\]"),
+    (lambda: ym.setThreads(0), r"setThreads: threads = 0 .*outside the allowed range \[1, \d+\]"),
+    # dpgkPointUpdate took NaN increments (NaN state out) and negative dt
+    (lambda: _upd(strainInc=[math.nan, 0, 0, 0]), r"dpgkPointUpdate2D: strainInc\[0\] = nan \[-\] is outside"),
+    (lambda: _upd(stress=[0, 0, 0, math.inf]), r"dpgkPointUpdate2D: stress\[3\] = inf \[Pa\] is outside"),
+    (lambda: _upd(dt=-1e-6), r"dpgkPointUpdate2D: dt = -1e-06 \[s\] is outside the allowed range \[0, inf\)"),
+    (lambda: _upd(damage=1.5), r"dpgkPointUpdate2D: damage = 1.5 \[-\] is outside the allowed range \[0, 1\]"),
+    (lambda: _upd(epsP=-0.1), r"dpgkPointUpdate2D: epsP .* = -0.1 \[-\] is outside the allowed range \[0, inf\)"),
+    (lambda: _upd(eps0=0.0), r"dpgkPointUpdate2D: eps0 .* = 0 \[-\] is outside the allowed range \(0, inf\)"),
+    (lambda: _upd(material=ym.rocks.granite()), r"dpgkPointUpdate2D: material must be a DpGkMat \(got ElasticMat\)"),
+    (lambda: _upd(epsP="a"), r"dpgkPointUpdate2D: epsP .* must be a number"),
+])
+def test_binding_arguments_named(call, msg):
+    with pytest.raises(ValueError, match=msg):
+        call()
+
+
+def test_too_many_threads_refused_not_crashing():
+    """setThreads(100000) then a step segfaulted; 1000 made libgomp abort. In a subprocess, so a
+    regression shows as a failed test, not a dead test run."""
+    code = ("import yade_mpm as ym\n"
+            "try:\n    ym.setThreads(100000)\nexcept ValueError as e:\n    print('REFUSED', e)\n"
+            "s = ym.make_solver((0, 0), (1, 1), 0.1)\n"
+            "ym.add_region(s, ym.rocks.granite(), (0, 0), (1, 1))\ns.run(2)\nprint('STEPPED', s.steps)\n")
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(ym.__file__)), OMP_NUM_THREADS="1")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr[-500:]
+    assert re.search(r"REFUSED setThreads: threads = 100000 .*outside the allowed range \[1, \d+\]", r.stdout)
+    assert "STEPPED 2" in r.stdout
