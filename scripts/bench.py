@@ -94,19 +94,30 @@ def build_paper(name):
 
 def run_paper(name, steps, warmup):
     """Child process: time `steps` steps of a paper-scale scene; extrapolate to its simulated end time."""
+    out, s = timed(lambda: build_paper(name), steps, warmup)
+    out.update(dt=s.lastDt, courant=s.courant)
+    return out
+
+
+def timed(build, steps, warmup, advance=None):
+    """Build a scene (`build()` → solver), run `warmup` steps, then time `steps` more with nothing else
+    happening: wall and CPU seconds, phase times, particles, storage and peak-RSS growth per particle,
+    threads and the plastic/damaged shares. advance(n) steps the scene (default: Solver.run, the C++
+    loop). Returns (result dict, solver)."""
     import yade_mpm as ym
     rss0 = peak_rss_bytes()
-    s = build_paper(name)
-    s.run(warmup)
+    s = build()
+    advance = advance or s.run
+    advance(warmup)
     s.resetPhaseTimes()
     c0, t0 = time.process_time(), time.perf_counter()
-    s.run(steps)
+    advance(steps)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles, dt=s.lastDt,
-               courant=s.courant, threads=ym.getThreads(), bytes_per_particle=s.bytesPerParticle,
-               rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles)
+    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles,
+               bytes_per_particle=s.bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
+               threads=ym.getThreads())
     out.update(material_stats(s))
-    return out
+    return out, s
 
 
 def host_probe(nproc, secs=2.0):
@@ -127,20 +138,8 @@ def peak_rss_bytes():
 
 def run_direct(name, steps, warmup):
     """Child process: build, warm up, time `steps` solver steps."""
-    import yade_mpm as ym
     dim, material, cells, _, _ = CASES[name]
-    rss0 = peak_rss_bytes()
-    s = build_scene(dim, material, cells)
-    s.run(warmup)
-    s.resetPhaseTimes()
-    c0, t0 = time.process_time(), time.perf_counter()
-    s.run(steps)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles,
-               bytes_per_particle=s.bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
-               threads=ym.getThreads())
-    out.update(material_stats(s))
-    return out
+    return timed(lambda: build_scene(dim, material, cells), steps, warmup)[0]
 
 
 def material_stats(s):
@@ -159,16 +158,13 @@ def run_yade(name, steps, warmup):
     from yade import O
     from yade.wrapper import ForceResetter, NewtonIntegrator
     dim, material, cells, _, _ = CASES[name]
-    s = build_scene(dim, material, cells)
-    e = ym.MpmEngine(s, label="mpmbench")
-    O.engines = [ForceResetter(), e.runner(), NewtonIntegrator()]
-    O.dt = 1.0
-    O.run(warmup, True)
-    s.resetPhaseTimes()
-    c0, t0 = time.process_time(), time.perf_counter()
-    O.run(steps, True)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    return dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles, threads=ym.getThreads())
+
+    def build():
+        s = build_scene(dim, material, cells)
+        O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmbench").runner(), NewtonIntegrator()]
+        O.dt = 1.0
+        return s
+    return timed(build, steps, warmup, advance=lambda n: O.run(n, True))[0]
 
 
 def run_hook_probe(name, steps, warmup):
