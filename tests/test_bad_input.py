@@ -172,3 +172,71 @@ def test_too_many_threads_refused_not_crashing():
     assert r.returncode == 0, r.stderr[-500:]
     assert re.search(r"REFUSED setThreads: threads = 100000 .*outside the allowed range \[1, \d+\]", r.stdout)
     assert "STEPPED 2" in r.stdout
+
+
+# ---- geometry and scene helpers (Python side)
+@pytest.mark.parametrize("make, msg", [
+    (lambda: ym.Circle((np.nan, 0.5), 0.2), r"Circle center = \(nan, 0.5\) m must be finite"),
+    (lambda: ym.Circle((0.5, 0.5), np.inf), r"Circle radius = inf m is outside the allowed range \(0, inf\)"),
+    (lambda: ym.Box((0, np.nan), (1, 1)), r"Box lo = \(0.0, nan\) m must be finite"),
+    (lambda: ym.Polygon([(0, 0), (1, 0), (np.inf, 1)]), r"Polygon vertices must be finite"),
+    (lambda: ym.Polygon([(0, 0), (1, 1), (2, 2)]), r"zero area"),
+    (lambda: ym.rotated_rectangle((np.nan, 0.5), 0.4, 0.1, 0.3), r"rotated_rectangle center = \(nan, 0.5\) m must be finite"),
+    (lambda: ym.rotated_rectangle((0.5, 0.5), 0.4, 0.1, np.inf), r"rotated_rectangle angle = inf rad"),
+    (lambda: ym.rotated_rectangle((0.5, 0.5), -0.4, 0.1, 0.0), r"rotated_rectangle length = -0.4 m is outside the allowed range \(0, inf\)"),
+])
+def test_hole_with_nonfinite_geometry_refused(make, msg):
+    """A NaN/inf centre, vertex or angle made a hole that silently removed nothing."""
+    with pytest.raises(ValueError, match=msg):
+        make()
+
+
+def test_hole_dimension_must_match_region():
+    """A 2D Circle in a 3D region was a NumPy broadcast error; now it names the hole."""
+    with pytest.raises(ValueError, match=r"holes\[0\] is a 2D Circle but the region is 3D"):
+        ym.fill_region((0, 0, 0), (1, 1, 1), 0.25, holes=[ym.Circle((0.5, 0.5), 0.2)])
+    with pytest.raises(ValueError, match=r"holes\[1\] is a 3D Box but the region is 2D"):
+        ym.fill_region((0, 0), (1, 1), 0.1, holes=[ym.Circle((0.5, 0.5), 0.2), ym.Box((0, 0, 0), (1, 1, 1))])
+    s3 = ym.make_solver((0, 0, 0), (1, 1, 1), 0.25)
+    with pytest.raises(ValueError, match=r"region lo = \(0, 0\) must have 3 components for a 3D solver"):
+        ym.add_region(s3, ym.rocks.granite(), (0, 0), (1, 1))
+    # a polygon is a prism along z in 3D: allowed, and it removes the prism (volume check)
+    sq = ym.Polygon([(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)])
+    x, v = ym.fill_region((0, 0, 0), (1, 1, 1), 0.125, ppc=1, holes=[sq])
+    assert len(x) * v == pytest.approx(1 - 0.5 * 0.5 * 1)
+
+
+def test_face_traction_on_a_face_without_particles_refused():
+    """apply_face_traction on a face that is not the lattice edge used to apply nothing, silently."""
+    s = _solver()
+    ym.add_region(s, ym.rocks.granite(), (0, 0), (1, 1))
+    with pytest.raises(ValueError, match=r"face x1 = 5.0 m \(side \+1\) has no particles in row 0.*span \[0.025, 0.975\] m"):
+        ym.apply_face_traction(s, 1, 1, 5.0, (0, -1e6))
+    with pytest.raises(ValueError, match=r"face = nan m"):
+        ym.apply_face_traction(s, 1, 1, np.nan, (0, -1e6))
+    with pytest.raises(ValueError, match=r"traction must have shape \(2,\) \[Pa\] for a 2D solver \(got \(3,\)\)"):
+        ym.apply_face_traction(s, 1, 1, 1.0, (0, -1e6, 0))
+    with pytest.raises(ValueError, match=r"indices is empty"):
+        ym.apply_traction(s, [], (0, 1e6), 0.05)
+    with pytest.raises(ValueError, match=r"indices must be a 1-D array of integer"):
+        ym.apply_traction(s, [0.5], (0, 1e6), 0.05)      # was truncated to slot 0
+    # the accepted face load is the traction times the face area, whatever the row split (Σβ = 1)
+    ym.apply_face_traction(s, 1, 1, 1.0, (0, -1e6))
+    fy = s.view("trac1")
+    assert fy.sum() == pytest.approx(-1e6 * 1.0 * 1.0, rel=1e-12)   # t · (1 m face × 1 m thickness)
+
+
+@pytest.mark.parametrize("call, msg", [
+    (lambda: ym.make_solver((0, 0), (1, np.nan), 0.1), r"make_solver hi = \(1.0, nan\) m must be finite"),
+    (lambda: ym.make_solver((0, 0), (1, 1), "a"), r"spacing must be a number \[m\]"),
+    (lambda: ym.fill_region((0, 0), (1, np.inf), 0.1), r"region hi = \(1.0, inf\) m must be finite"),
+    (lambda: ym.fill_region((0, 0), (1, 1), 0.1, keep=lambda x: np.ones(3, bool)), r"keep returned shape \(3,\)"),
+    (lambda: ym.boundary_particles(_solver(), 0, 1), r"the solver has no particles"),
+    (lambda: ym.boundary_particles(_solver(), 5, 1), r"axis = 5 must be an integer in \[0, 1\]"),
+    (lambda: ym.set_initial_stress(_solver(), "abcd"), r"initial stress must be 4 numbers"),
+    (lambda: ym.consistent_row_weights(10 ** 6), r"ppc = 1000000 must be an integer in \[2, 16\]"),
+    (lambda: ym.add_region(None, ym.rocks.granite(), (0, 0), (1, 1)), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
+])
+def test_scene_helpers_name_the_parameter(call, msg):
+    with pytest.raises(ValueError, match=msg):
+        call()

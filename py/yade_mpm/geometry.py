@@ -4,12 +4,36 @@ sub-cells of the background grid, so a grid aligned with the region gives a regu
 import numpy as np
 
 
+def _number(v, name, unit, positive=False):
+    """A finite float (> 0 if positive) or ValueError naming the parameter, unit and range."""
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number [{unit}] (got {type(v).__name__} {v!r})") from None
+    if not np.isfinite(f) or (positive and not f > 0):
+        raise ValueError(f"{name} = {v} {unit} is outside the allowed range {'(0, inf)' if positive else '(-inf, inf)'}")
+    return f
+
+
+def _point(v, name, dims=(2, 3)):
+    """A finite point with 2 or 3 components [m], or ValueError naming the parameter."""
+    try:
+        p = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {' or '.join(map(str, dims))} numbers [m] (got {type(v).__name__} {v!r})") from None
+    if p.ndim != 1 or len(p) not in dims:
+        raise ValueError(f"{name} must have {' or '.join(map(str, dims))} components [m] (got shape {p.shape})")
+    if not np.all(np.isfinite(p)):
+        raise ValueError(f"{name} = {tuple(p.tolist())} m must be finite (a NaN or inf coordinate removes nothing)")
+    return p
+
+
 class Circle:
     """Disc (2D) or sphere (3D) of given centre [m] and radius [m]."""
     def __init__(self, center, radius):
-        self.center, self.radius = np.asarray(center, float), float(radius)
-        if not self.radius > 0:
-            raise ValueError(f"Circle radius = {radius} m must be > 0")
+        self.center = _point(center, "Circle center")
+        self.radius = _number(radius, "Circle radius", "m", positive=True)
+        self.dims = (len(self.center),)
 
     def contains(self, x):
         return np.sum((x - self.center) ** 2, axis=1) < self.radius ** 2
@@ -18,9 +42,12 @@ class Circle:
 class Box:
     """Axis-aligned box [lo, hi] [m]."""
     def __init__(self, lo, hi):
-        self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
+        self.lo, self.hi = _point(lo, "Box lo"), _point(hi, "Box hi")
+        if self.lo.shape != self.hi.shape:
+            raise ValueError(f"Box lo {tuple(self.lo)} and hi {tuple(self.hi)} must have the same number of components")
         if np.any(self.hi <= self.lo):
             raise ValueError(f"Box hi {hi} must exceed lo {lo} on every axis")
+        self.dims = (len(self.lo),)
 
     def contains(self, x):
         return np.all((x >= self.lo) & (x <= self.hi), axis=1)
@@ -28,10 +55,20 @@ class Box:
 
 class Polygon:
     """Closed 2D polygon given by its vertices [m] (any orientation); in 3D it is a prism along z."""
+    dims = (2, 3)
+
     def __init__(self, vertices):
-        self.v = np.asarray(vertices, float)
+        try:
+            self.v = np.asarray(vertices, float)
+        except (TypeError, ValueError):
+            raise ValueError(f"Polygon vertices must be an (n ≥ 3, 2) array of numbers [m] (got {type(vertices).__name__})") from None
         if self.v.ndim != 2 or self.v.shape[1] != 2 or len(self.v) < 3:
-            raise ValueError("Polygon vertices must be an (n ≥ 3, 2) array")
+            raise ValueError(f"Polygon vertices must be an (n ≥ 3, 2) array [m] (got shape {self.v.shape})")
+        if not np.all(np.isfinite(self.v)):
+            raise ValueError("Polygon vertices must be finite (a NaN or inf vertex removes nothing)")
+        x, y = self.v[:, 0], self.v[:, 1]
+        if not abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) > 0:
+            raise ValueError("Polygon vertices enclose zero area (all on one line)")
 
     def contains(self, x):
         px, py = x[:, 0], x[:, 1]
@@ -48,24 +85,30 @@ class Polygon:
 
 def rotated_rectangle(center, length, width, angle):
     """Polygon of a rectangle (a flaw) of given length/width [m] rotated by angle [rad] from x."""
+    center = _point(center, "rotated_rectangle center", dims=(2,))
+    length = _number(length, "rotated_rectangle length", "m", positive=True)
+    width = _number(width, "rotated_rectangle width", "m", positive=True)
+    angle = _number(angle, "rotated_rectangle angle", "rad")
     c, s = np.cos(angle), np.sin(angle)
     hl, hw = length / 2, width / 2
     pts = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-    return Polygon(pts @ np.array([[c, s], [-s, c]]) + np.asarray(center, float))
+    return Polygon(pts @ np.array([[c, s], [-s, c]]) + center)
 
 
 def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
     """Particle centres and volume for the box [lo, hi] on a grid of spacing l with ppc particles per
     cell per axis, minus the holes. Returns (positions (N, D), volume per particle [m³])."""
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    if lo.shape != hi.shape or lo.ndim != 1 or len(lo) not in (2, 3):
-        raise ValueError("lo and hi must both have 2 or 3 components")
-    if not spacing > 0:
-        raise ValueError(f"spacing = {spacing} m must be > 0")
-    if int(ppc) != ppc or ppc < 1:
-        raise ValueError(f"ppc (particles per cell per axis) = {ppc} must be an integer ≥ 1")
+    lo, hi = _point(lo, "region lo"), _point(hi, "region hi")
+    if lo.shape != hi.shape:
+        raise ValueError("region lo and hi must both have 2 or 3 components")
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or ppc < 1:
+        raise ValueError(f"ppc (particles per cell per axis) = {ppc!r} must be an integer ≥ 1")
     if np.any(hi <= lo):
-        raise ValueError("hi must exceed lo on every axis")
+        raise ValueError(f"region hi {tuple(hi)} must exceed lo {tuple(lo)} on every axis")
+    holes = _holes(holes, len(lo))
+    if keep is not None and not callable(keep):
+        raise ValueError(f"keep must be a function of the (N, {len(lo)}) positions returning N booleans (got {type(keep).__name__})")
     d = spacing / ppc
     axes = [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)]
     grids = np.meshgrid(*axes, indexing="ij")
@@ -74,8 +117,28 @@ def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
     for h in holes:
         mask &= ~h.contains(x)
     if keep is not None:
-        mask &= keep(x)
+        k = np.asarray(keep(x))
+        if k.shape != (len(x),):
+            raise ValueError(f"keep returned shape {k.shape}; expected ({len(x)},): one boolean per position")
+        mask &= k.astype(bool)
     x = x[mask]
     if len(x) == 0:
         raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
     return x, d ** len(lo)
+
+
+def _holes(holes, dim):
+    """The holes as a list of shapes whose dimension matches the region (2D circle in 3D: refused)."""
+    if hasattr(holes, "contains"):
+        holes = [holes]
+    try:
+        holes = list(holes)
+    except TypeError:
+        raise ValueError(f"holes must be a list of Circle/Box/Polygon shapes (got {type(holes).__name__})") from None
+    for k, h in enumerate(holes):
+        if not hasattr(h, "contains"):
+            raise ValueError(f"holes[{k}] must be a Circle, Box or Polygon (got {type(h).__name__})")
+        dims = getattr(h, "dims", (dim,))
+        if dim not in dims:
+            raise ValueError(f"holes[{k}] is a {'/'.join(f'{d}D' for d in dims)} {type(h).__name__} but the region is {dim}D")
+    return holes

@@ -2,7 +2,7 @@
 surface tractions, and id-ordered copies of particle fields for post-processing."""
 import numpy as np
 from . import _core
-from .geometry import fill_region
+from .geometry import _number, _point, fill_region
 
 SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz")}
 
@@ -10,12 +10,11 @@ SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz"
 def make_solver(lo, hi, spacing, margin=2):
     """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
     on every side, with grid spacing l = spacing [m]."""
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    if lo.shape != hi.shape or len(lo) not in (2, 3):
+    lo, hi = _point(lo, "make_solver lo"), _point(hi, "make_solver hi")
+    if lo.shape != hi.shape:
         raise ValueError("lo and hi must both have 2 (plane strain) or 3 components")
-    if not (np.isfinite(spacing) and spacing > 0):
-        raise ValueError(f"spacing = {spacing} m must be finite and > 0")
-    if int(margin) != margin or margin < 0:
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    if isinstance(margin, bool) or not isinstance(margin, (int, np.integer)) or margin < 0:
         raise ValueError(f"margin = {margin} cells must be an integer ≥ 0")
     cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin)
     origin = lo - margin * spacing
@@ -24,12 +23,20 @@ def make_solver(lo, hi, spacing, margin=2):
 
 
 def dim_of(solver):
-    return 2 if isinstance(solver, _core.Solver2D) else 3
+    """2 or 3; ValueError if `solver` is not a Solver2D/Solver3D."""
+    if isinstance(solver, _core.Solver2D):
+        return 2
+    if isinstance(solver, _core.Solver3D):
+        return 3
+    raise ValueError(f"solver must be a Solver2D or Solver3D (got {type(solver).__name__})")
 
 
 def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None):
     """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2);
     assigns the material to the solver. Returns the storage indices range start (particle ids)."""
+    d = dim_of(solver)
+    if np.ndim(lo) != 1 or len(lo) != d:
+        raise ValueError(f"region lo = {lo} must have {d} components for a {d}D solver")
     x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
     first = solver.numParticles
     solver.setMaterial(material)
@@ -107,10 +114,13 @@ def _optional(solver, name):
 def set_initial_stress(solver, stress):
     """In-situ stress for every particle: components (xx, yy, zz, xy[, xz, yz]) [Pa], tension positive."""
     d = dim_of(solver)
-    stress = np.asarray(stress, float)
     n = len(SYM_NAMES[d])
+    try:
+        stress = np.asarray(stress, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"initial stress must be {n} numbers {SYM_NAMES[d]} [Pa] (got {type(stress).__name__} {stress!r})") from None
     if stress.shape != (n,) or not np.all(np.isfinite(stress)):
-        raise ValueError(f"initial stress must be {n} finite components {SYM_NAMES[d]} [Pa]")
+        raise ValueError(f"initial stress must be {n} finite components {SYM_NAMES[d]} [Pa] (got {stress.tolist()})")
     for k in range(n):
         solver.view(f"sig{k}")[:] = stress[k]
     solver.requestSort()
@@ -118,8 +128,11 @@ def set_initial_stress(solver, stress):
 
 def boundary_particles(solver, axis, side, tol=None):
     """Storage indices of the particle layer nearest the region face `side` (-1 low, +1 high) of `axis`."""
+    _axis_side(solver, axis, side)
+    d = solver.spacing / 2 if tol is None else _number(tol, "tol", "m", positive=True)
+    if solver.numParticles == 0:
+        raise ValueError("boundary_particles: the solver has no particles")
     x = solver.view(f"x{axis}")
-    d = solver.spacing / 2 if tol is None else tol
     edge = x.min() if side < 0 else x.max()
     return np.nonzero(np.abs(x - edge) < 0.5 * d)[0]
 
@@ -129,16 +142,40 @@ def apply_traction(solver, indices, traction, area):
     × 1 m]: adds the surface force t·area to each particle (Eq. 22). Indices are storage slots; call
     before stepping (the solver re-sorts particles but carries the forces with them)."""
     d = dim_of(solver)
-    t = np.broadcast_to(np.asarray(traction, float), (len(indices), d))
-    if not np.all(np.isfinite(t)):
-        raise ValueError("traction must be finite [Pa]")
-    if not area > 0:
-        raise ValueError(f"area = {area} m² must be > 0")
+    idx = np.asarray(indices)
+    if idx.ndim != 1 or not (idx.dtype.kind in "iu" or len(idx) == 0):
+        raise ValueError(f"indices must be a 1-D array of integer particle slots (got dtype {idx.dtype}, shape {idx.shape})")
+    if len(idx) == 0:
+        raise ValueError("indices is empty: the traction would be applied to no particle")
+    t = _traction(traction, d, len(idx))
+    area = _number(area, "area", "m²", positive=True)
+    indices = idx
     try:
         old = np.column_stack([solver.view(f"trac{a}")[indices] for a in range(d)])
     except ValueError:
         old = 0.0
     solver.setParticleForces(np.asarray(indices, np.int64), old + t * area)
+
+
+def _axis_side(solver, axis, side):
+    d = dim_of(solver)
+    if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)) or not 0 <= axis < d:
+        raise ValueError(f"axis = {axis!r} must be an integer in [0, {d - 1}]")
+    if isinstance(side, bool) or side not in (-1, 1):
+        raise ValueError(f"side = {side!r} must be -1 (material above the face) or +1 (material below)")
+
+
+def _traction(traction, d, n=None):
+    """Traction [Pa] as a finite D-vector (or (n, D) rows), or ValueError naming it."""
+    try:
+        t = np.asarray(traction, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"traction must be {d} numbers [Pa] (got {type(traction).__name__} {traction!r})") from None
+    if t.shape != (d,) and not (n is not None and t.shape == (n, d)):
+        raise ValueError(f"traction must have shape ({d},){'' if n is None else f' or ({n}, {d})'} [Pa] for a {d}D solver (got {t.shape})")
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"traction = {t.tolist()} Pa must be finite")
+    return np.broadcast_to(t, (n, d)) if n is not None else t
 
 
 def _bspline3(t):
@@ -158,6 +195,9 @@ def consistent_row_weights(ppc):
     on the circular opening). The problem factorises per axis, so a 1D solve over 3·ppc rows is exact,
     also at corners. Valid for a flat face on a cell boundary of the grid with ppc particles per cell
     per axis and no other free face within 3 cells. Cells are the unit of length here."""
+    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or not 2 <= ppc <= 16:
+        raise ValueError(f"ppc = {ppc!r} must be an integer in [2, 16] for a consistent face load "
+                         "(ppc = 1 has none: load the outer row, consistent=False)")
     rows = (np.arange(10 * ppc) + 0.5) / ppc           # particle rows inside the face at x = 0
     nodes = np.arange(-2, 7)                          # node columns whose support the first rows touch
     # internal force per unit stress (up to the common factor V·Σw_y): Σ_k w_i(x_k)(x_i − x_k)·3
@@ -175,15 +215,25 @@ def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=Tr
     with ppc particles per cell per axis, side = -1 when the material lies above the face, +1 below.
     consistent=True spreads it over the outer rows with consistent_row_weights (recommended: exact
     equilibrium with a uniform stress); False puts it all on the outermost row. Call before stepping."""
-    if side not in (-1, 1):
-        raise ValueError(f"side = {side} must be -1 (material above the face) or +1 (material below)")
-    if not (0 <= axis < dim_of(solver)):
-        raise ValueError(f"axis = {axis} must be in [0, {dim_of(solver) - 1}]")
+    _axis_side(solver, axis, side)
+    d = dim_of(solver)
+    face = _number(face, "face", "m")
+    t = _traction(traction, d)
+    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or ppc < 1:
+        raise ValueError(f"ppc (particles per cell per axis) = {ppc!r} must be an integer ≥ 1")
     dp = solver.spacing / ppc                         # particle spacing = face length of a boundary particle
     beta = consistent_row_weights(ppc) if consistent else np.array([1.0])
+    if solver.numParticles == 0:
+        raise ValueError("apply_face_traction: the solver has no particles")
     x = solver.view(f"x{axis}")
     depth = (x - face) if side < 0 else (face - x)
     row = np.round(depth / dp - 0.5).astype(int)      # 0 = outermost particle row
-    area = dp ** (dim_of(solver) - 1)                 # 2D: face length × 1 m thickness
-    for k, b in enumerate(beta):
-        apply_traction(solver, np.nonzero(row == k)[0], b * np.asarray(traction, float), area)
+    rows = [np.nonzero(row == k)[0] for k in range(len(beta))]
+    for k, r in enumerate(rows):                       # a face off the lattice applied nothing before
+        if len(r) == 0:
+            raise ValueError(f"face x{axis} = {face} m (side {side:+d}) has no particles in row {k} of the {len(beta)} loaded rows: "
+                             f"the particles span [{x.min():.6g}, {x.max():.6g}] m along axis {axis}; the face must be the "
+                             f"{'lower' if side < 0 else 'upper'} edge of the particle lattice")
+    area = dp ** (d - 1)                              # 2D: face length × 1 m thickness
+    for r, b in zip(rows, beta):
+        apply_traction(solver, r, b * t, area)
