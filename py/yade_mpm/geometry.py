@@ -28,6 +28,23 @@ def _point(v, name, dims=(2, 3)):
     return p
 
 
+def _integer(v, name, lo, hi=None):
+    """An integer in [lo, hi] (bools and floats refused), or ValueError naming the parameter and range."""
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo or (hi is not None and v > hi):
+        raise ValueError(f"{name} = {v!r} must be an integer in [{lo}, {'inf' if hi is None else hi}]")
+    return int(v)
+
+
+def _corners(lo, hi, who):
+    """Finite corners lo < hi of a box with 2 or 3 components, or ValueError naming them."""
+    lo, hi = _point(lo, f"{who} lo"), _point(hi, f"{who} hi")
+    if lo.shape != hi.shape:
+        raise ValueError(f"{who} lo and hi must both have 2 (plane strain) or 3 components")
+    if np.any(hi <= lo):
+        raise ValueError(f"{who} hi {tuple(hi)} must exceed lo {tuple(lo)} on every axis")
+    return lo, hi
+
+
 class Circle:
     """Disc (2D) or sphere (3D) of given centre [m] and radius [m]."""
     def __init__(self, center, radius):
@@ -42,11 +59,7 @@ class Circle:
 class Box:
     """Axis-aligned box [lo, hi] [m]."""
     def __init__(self, lo, hi):
-        self.lo, self.hi = _point(lo, "Box lo"), _point(hi, "Box hi")
-        if self.lo.shape != self.hi.shape:
-            raise ValueError(f"Box lo {tuple(self.lo)} and hi {tuple(self.hi)} must have the same number of components")
-        if np.any(self.hi <= self.lo):
-            raise ValueError(f"Box hi {hi} must exceed lo {lo} on every axis")
+        self.lo, self.hi = _corners(lo, hi, "Box")
         self.dims = (len(self.lo),)
 
     def contains(self, x):
@@ -98,14 +111,9 @@ def rotated_rectangle(center, length, width, angle):
 def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
     """Particle centres and volume for the box [lo, hi] on a grid of spacing l with ppc particles per
     cell per axis, minus the holes. Returns (positions (N, D), volume per particle [m³])."""
-    lo, hi = _point(lo, "region lo"), _point(hi, "region hi")
-    if lo.shape != hi.shape:
-        raise ValueError("region lo and hi must both have 2 or 3 components")
+    lo, hi = _corners(lo, hi, "region")
     spacing = _number(spacing, "spacing", "m", positive=True)
-    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or ppc < 1:
-        raise ValueError(f"ppc (particles per cell per axis) = {ppc!r} must be an integer ≥ 1")
-    if np.any(hi <= lo):
-        raise ValueError(f"region hi {tuple(hi)} must exceed lo {tuple(lo)} on every axis")
+    ppc = _integer(ppc, "ppc (particles per cell per axis)", 1)
     holes = _holes(holes, len(lo))
     if keep is not None and not callable(keep):
         raise ValueError(f"keep must be a function of the (N, {len(lo)}) positions returning N booleans (got {type(keep).__name__})")

@@ -2,7 +2,7 @@
 surface tractions, and id-ordered copies of particle fields for post-processing."""
 import numpy as np
 from . import _core
-from .geometry import _number, _point, fill_region
+from .geometry import _corners, _integer, _number, fill_region
 
 SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz")}
 
@@ -10,12 +10,9 @@ SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz"
 def make_solver(lo, hi, spacing, margin=2):
     """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
     on every side, with grid spacing l = spacing [m]."""
-    lo, hi = _point(lo, "make_solver lo"), _point(hi, "make_solver hi")
-    if lo.shape != hi.shape:
-        raise ValueError("lo and hi must both have 2 (plane strain) or 3 components")
+    lo, hi = _corners(lo, hi, "make_solver")
     spacing = _number(spacing, "spacing", "m", positive=True)
-    if isinstance(margin, bool) or not isinstance(margin, (int, np.integer)) or margin < 0:
-        raise ValueError(f"margin = {margin} cells must be an integer ≥ 0")
+    margin = _integer(margin, "margin [cells]", 0)
     cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin)
     origin = lo - margin * spacing
     cls = _core.Solver2D if len(lo) == 2 else _core.Solver3D
@@ -159,8 +156,7 @@ def apply_traction(solver, indices, traction, area):
 
 def _axis_side(solver, axis, side):
     d = dim_of(solver)
-    if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)) or not 0 <= axis < d:
-        raise ValueError(f"axis = {axis!r} must be an integer in [0, {d - 1}]")
+    _integer(axis, "axis", 0, d - 1)
     if isinstance(side, bool) or side not in (-1, 1):
         raise ValueError(f"side = {side!r} must be -1 (material above the face) or +1 (material below)")
 
@@ -195,9 +191,7 @@ def consistent_row_weights(ppc):
     on the circular opening). The problem factorises per axis, so a 1D solve over 3·ppc rows is exact,
     also at corners. Valid for a flat face on a cell boundary of the grid with ppc particles per cell
     per axis and no other free face within 3 cells. Cells are the unit of length here."""
-    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or not 2 <= ppc <= 16:
-        raise ValueError(f"ppc = {ppc!r} must be an integer in [2, 16] for a consistent face load "
-                         "(ppc = 1 has none: load the outer row, consistent=False)")
+    _integer(ppc, "ppc (ppc = 1 has no consistent face load: use consistent=False)", 2, 16)
     rows = (np.arange(10 * ppc) + 0.5) / ppc           # particle rows inside the face at x = 0
     nodes = np.arange(-2, 7)                          # node columns whose support the first rows touch
     # internal force per unit stress (up to the common factor V·Σw_y): Σ_k w_i(x_k)(x_i − x_k)·3
@@ -219,8 +213,7 @@ def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=Tr
     d = dim_of(solver)
     face = _number(face, "face", "m")
     t = _traction(traction, d)
-    if isinstance(ppc, bool) or not isinstance(ppc, (int, np.integer)) or ppc < 1:
-        raise ValueError(f"ppc (particles per cell per axis) = {ppc!r} must be an integer ≥ 1")
+    _integer(ppc, "ppc (particles per cell per axis)", 1)
     dp = solver.spacing / ppc                         # particle spacing = face length of a boundary particle
     beta = consistent_row_weights(ppc) if consistent else np.array([1.0])
     if solver.numParticles == 0:
