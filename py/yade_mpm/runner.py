@@ -10,6 +10,14 @@ or given simulated times.
                      stop=lambda s: s.kineticEnergy() < 1e-6)
     res.reason    # "end_time", "max_steps", "stop" or "interrupted"
 
+With periodic checkpoints and a clean stop on SIGTERM as well (yade_mpm.checkpoint):
+
+    ck = checkpoint.Checkpointer("out/run.ckpt", every_minutes=30, solvers=solver)
+    with ck.signals():                                         # SIGINT/SIGTERM set ck.stop_requested
+        runner.run(solver, end_time=T, stop=lambda s: ck.stop_requested,
+                   outputs=[runner.Output(lambda s: ck.tick(s.steps), steps=100),
+                            runner.Output(lambda s: ck.save(s.steps), at_end=True)])
+
 A callback is ``f(solver)``; it may return ``runner.STOP`` to end the run after this step (a
 convergence check that is expensive to evaluate every step). ``stop(solver)`` is evaluated after every
 step. Ctrl-C (KeyboardInterrupt) ends the run cleanly: the ``at_end`` outputs are called with the
@@ -149,6 +157,8 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
 
     wall0 = _time.time()
     taken, reason = 0, None
+    if prog is not None:
+        prog.update(solver.steps, solver.time)    # the first update fixes where the ETA counts from
     for o in outs:
         o._begin(solver)
     try:
