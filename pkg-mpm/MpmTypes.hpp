@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -32,6 +33,29 @@ struct InputError : std::invalid_argument {
 struct SimulationError : std::runtime_error {
 	using std::runtime_error::runtime_error;
 };
+
+// First failure of a parallel particle pass. The lowest particle slot wins, so the message is the same
+// for any thread count; threads record and go on, the caller throws after the pass (SimulationError).
+struct ErrorRecord {
+	size_t      particle = SIZE_MAX;
+	std::string what;
+	void        clear() { particle = SIZE_MAX, what.clear(); }
+	bool        none() const { return particle == SIZE_MAX; }
+	void        record(size_t p, const std::string& w)
+	{
+#pragma omp critical(mpm_error)
+		if (p < particle) particle = p, what = w;
+	}
+};
+
+// A number for messages (6 significant digits).
+inline std::string fmtNum(Real v)
+{
+	std::ostringstream o;
+	o.precision(6);
+	o << v;
+	return o.str();
+}
 
 inline void requireFinite(Real v, const char* name)
 {

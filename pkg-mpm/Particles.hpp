@@ -55,6 +55,67 @@ struct Particles {
 		if (!epsP.empty()) f(epsP), f(damage), f(eps0);
 	}
 
+	// Appends n particles (positions x[p·D + a] [m], volumes [m³], masses [kg]) after checking every value;
+	// the grid spans [lo, hi). Throws InputError naming the particle and quantity, before any change.
+	template <class Vec>
+	void append(const Real* x, const Real* vol, const Real* mass, size_t n, const Vec& lo, const Vec& hi)
+	{
+		if (n == 0) throw InputError("particles: the particle set to add is empty");
+		for (size_t p = 0; p < n; ++p) {
+			const std::string who = "particle " + std::to_string(this->n + p);
+			for (int a = 0; a < D; ++a) {
+				Real xa = x[p * D + a];
+				if (!std::isfinite(xa)) throw InputError("position of " + who + " is not finite (NaN or inf)");
+				if (xa < lo[a] || xa >= hi[a])
+					throw InputError("position of " + who + " is outside the grid along axis " + std::to_string(a) + ": " + std::to_string(xa)
+					                 + " m not in [" + std::to_string(lo[a]) + ", " + std::to_string(hi[a]) + ") m");
+			}
+			if (!(std::isfinite(vol[p]) && vol[p] > 0))
+				throw InputError("volume of " + who + " must be finite and > 0 m³ (got " + std::to_string(vol[p]) + ")");
+			if (!(std::isfinite(mass[p]) && mass[p] > 0)) throw InputError("mass of " + who + " must be finite and > 0 kg (got " + std::to_string(mass[p]) + ")");
+		}
+		const size_t old = this->n;
+		this->n += n;
+		forEachRealField([&](std::vector<Real>& f) { f.resize(this->n, 0.0); });
+		id.resize(this->n);
+		for (size_t p = 0; p < n; ++p) {
+			for (int a = 0; a < D; ++a) this->x[a][old + p] = x[p * D + a];
+			this->vol[old + p] = vol0[old + p] = vol[p];
+			this->mass[old + p]                = mass[p];
+			id[old + p]                        = int64_t(old + p);
+		}
+	}
+
+	// Checks the state written from outside through views (like append's input) and summarises it.
+	struct Summary {
+		Real rhoMin = INFINITY, massMin = INFINITY, vmax = 0;
+	};
+	template <class Vec>
+	Summary check(const Vec& lo, const Vec& hi) const
+	{
+		Summary c;
+		for (size_t p = 0; p < n; ++p) {
+			auto who = [&] { return "particle id " + std::to_string(id[p]); }; // built only for a message
+			for (int a = 0; a < D; ++a)
+				if (!(x[a][p] >= lo[a] && x[a][p] < hi[a]))
+					throw InputError("position of " + who() + " along axis " + std::to_string(a) + " = " + fmtNum(x[a][p])
+					                 + " m is not finite or outside the grid [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m");
+			if (!(std::isfinite(mass[p]) && mass[p] > 0)) throw InputError("mass of " + who() + " = " + fmtNum(mass[p]) + " kg must be finite and > 0");
+			if (!(std::isfinite(vol[p]) && vol[p] > 0)) throw InputError("volume of " + who() + " = " + fmtNum(vol[p]) + " m³ must be finite and > 0");
+			c.rhoMin  = std::min(c.rhoMin, mass[p] / vol[p]);
+			c.massMin = std::min(c.massMin, mass[p]);
+			Real sp   = 0;
+			for (int a = 0; a < D; ++a) {
+				if (!std::isfinite(v[a][p])) throw InputError("velocity of " + who() + " is not finite");
+				sp += v[a][p] * v[a][p];
+			}
+			for (int k = 0; k < NS; ++k)
+				if (!std::isfinite(sig[k][p])) throw InputError("stress of " + who() + " is not finite");
+			c.vmax = std::max(c.vmax, std::sqrt(sp));
+		}
+		return c;
+	}
+
 	Sym<D> stress(size_t p) const
 	{
 		Sym<D> s;

@@ -1,0 +1,105 @@
+// The two particle phases that close a step (paper Fig. 2): the constitutive update from the MUSL
+// velocity gradient, then the position update with the stability and re-sort checks.
+#pragma once
+#include "Transfer.hpp"
+
+namespace mpm {
+
+// Velocity gradient from the MUSL nodal velocities (Eq. 7), strain increment (Eq. 29), Jaumann rotation,
+// material update (Eqs. 27–40), volume V ← det(I + Δt∇v) V. Returns the smallest density m/V (for Δt).
+// Failures (singular fit, non-finite stress, inverted volume) are recorded in err; the caller throws.
+template <int D, class Mat>
+inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRecord& err)
+{
+	Particles<D>& P      = tr.P;
+	const auto&   blocks = tr.sched.start;
+	const long    nb     = long(blocks.size()) - 1;
+	Real          rmin   = INFINITY;
+#pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin)
+	for (long b = 0; b < nb; ++b)
+		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
+			const size_t p = pp;
+			Real L[D][D] = {};
+			if (!tr.velocityGradient(p, L)) {
+				err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+				continue;
+			}
+			Sym<D> de; // Δε = sym(∇v) Δt, Eq. 29
+			Sym<D> s = P.stress(p);
+			strainIncrement(L, dt, de);
+			jaumannRotation(L, dt, s);
+			mat.update(P, p, s, de, dt); // Eqs. 27–40
+			P.setStress(p, s);
+			const Real J = jacobian(L, dt);
+			P.vol[p] *= J;
+			Real check = J; // one sum carries every value that must be finite (NaN/inf propagate)
+			for (int k = 0; k < Dim<D>::nSym; ++k) check += s.c[k];
+			if (!(std::isfinite(check) && J > 0)) {
+				static const char* comp[6] = { "xx", "yy", "zz", "xy", "xz", "yz" };
+				std::string        what    = "has non-positive volume change det(I + Δt∇v) = " + fmtNum(J) + " (element inverted)";
+				for (int k = Dim<D>::nSym - 1; k >= 0; --k)
+					if (!std::isfinite(s.c[k])) what = std::string("has non-finite stress σ") + comp[k] + " = " + fmtNum(s.c[k]);
+				err.record(p, what);
+				continue;
+			}
+			rmin = std::min(rmin, P.mass[p] / P.vol[p]);
+		}
+	return rmin;
+}
+
+// x ← x + Δt v (the G2P velocity). Checks that the particle stays finite and on the grid (else err) and
+// within the cells its block may reach before a re-sort (BlockSchedule::reach): *drift is set when one
+// left them, so the deterministic colouring stays valid. Returns max ‖v‖ (for Δt).
+template <int D>
+inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool& driftOut)
+{
+	Particles<D>&  P      = tr.P;
+	const Grid<D>& grid   = tr.grid;
+	const auto&    blocks = tr.sched.start;
+	const long     nb     = long(blocks.size()) - 1;
+	const auto     lo = grid.origin, hi = grid.upper();
+	const Real     invH  = 1.0 / grid.spacing;
+	Real           v2max = 0;
+	bool           drift = false;
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : v2max) reduction(|| : drift)
+	for (long b = 0; b < nb; ++b) {
+		Real cellLo[D], cellHi[D]; // cells a particle of block b may reach before a re-sort
+		tr.sched.reach(size_t(b), cellLo, cellHi);
+		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
+			const size_t p  = pp;
+			Real         sp = 0, check = 0;
+			bool         inside = true, near = true;
+			for (int a = 0; a < D; ++a) {
+				const Real va = P.v[a][p], xa = P.x[a][p] + dt * va;
+				P.x[a][p] = xa;
+				sp += va * va;
+				check += xa;
+				inside = inside && xa >= lo[a] && xa < hi[a];
+				const Real f = (xa - lo[a]) * invH;
+				near = near && f >= cellLo[a] && f < cellHi[a];
+			}
+			if (!(std::isfinite(check) && std::isfinite(sp))) {
+				std::string what = "has a non-finite position";
+				for (int a = D - 1; a >= 0; --a)
+					if (!std::isfinite(P.v[a][p])) what = "has non-finite velocity component " + std::to_string(a) + " = " + fmtNum(P.v[a][p]);
+				err.record(p, what);
+				continue;
+			}
+			if (!inside) {
+				for (int a = 0; a < D; ++a)
+					if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
+						err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (grid spans ["
+						                      + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m)");
+						break;
+					}
+				continue;
+			}
+			v2max = std::max(v2max, sp);
+			drift = drift || !near;
+		}
+	}
+	driftOut = drift;
+	return std::sqrt(v2max);
+}
+
+} // namespace mpm

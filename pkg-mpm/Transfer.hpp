@@ -1,0 +1,193 @@
+// Particle ↔ grid transfers of one step (paper Sec. 2.5, Fig. 2): P2G (Eqs. 20–22), G2P with the MUSL
+// remap (Eqs. 6–7, 16–17) and the particle velocity gradient from the MUSL nodal velocities (Eq. 7).
+//
+// Scatters run colour by colour over the particle blocks of BlockSchedule (blocks of one colour never
+// share a node, each block is summed by one thread in particle order): nodal sums are bitwise the same
+// for any thread count. p2g and g2p are called by every thread of the solver's parallel region
+// (orphaned worksharing loops); failures are recorded in an ErrorRecord, never thrown inside the region.
+#pragma once
+#include "BlockSchedule.hpp"
+#include "Kinematics.hpp"
+#include "Lanes.hpp"
+
+namespace mpm {
+
+template <int D>
+class Transfer {
+public:
+	using Vec           = typename Dim<D>::Vec;
+	Grid<D>&                grid;
+	Particles<D>&           P;
+	const BlockSchedule<D>& sched;
+	const StencilOffsets<D> offs; // linear-index offsets of the 4^D stencil nodes
+
+	Transfer(Grid<D>& g, Particles<D>& p, const BlockSchedule<D>& s) : grid(g), P(p), sched(s), offs(g) { }
+
+	// Particles of block b, in storage order.
+	template <class F>
+	void forBlock(uint32_t b, F&& f) const
+	{
+		for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) f(size_t(p));
+	}
+	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums).
+	template <class F>
+	void scatterPass(F&& f) const
+	{
+		for (int c = 0; c < Dim<D>::nColours; ++c) {
+			const auto& blocks = sched.colour[c];
+#pragma omp for schedule(dynamic, 1)
+			for (size_t k = 0; k < blocks.size(); ++k) forBlock(blocks[k], f);
+		}
+	}
+	void kernelOf(size_t p, Kernel<D>& k) const
+	{
+		Real x[D];
+		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+		computeKernel(grid, offs, x, k);
+	}
+
+	// ------------------------------------------------------------ P2G: Eqs. 20–22
+	// Every node receives w·(P0 + Σ_b A_b (x_i − x_p)_b) with the per-particle affine coefficients
+	// P0 = [m, m, m v, f_ext] and A_b = [0, 0, m C_·b, −V σ_·b 3/l²] (interior particles, where
+	// ∇ψ_i = w_i 3/l² (x_i − x_p)); particles with a general WLS stencil go through the full ψ, ∇ψ.
+	// Sign of Eq. 21 in code: stress is tension-positive and f_int,i = −Σ_p V_p σ_p ∇ψ_i(x_p).
+	// loadScale multiplies the particle surface forces (traction ramp).
+	template <class Mat>
+	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, ErrorRecord& err)
+	{
+		auto& nodes = grid.nodes;
+#pragma omp for schedule(static)
+		for (size_t i = 0; i < nodes.size(); ++i) lanes(nodes[i]) = NodeLanes {}; // padding lanes too
+		const Real s    = loadScale;
+		const Real Dinv = 3.0 / (grid.spacing * grid.spacing); // interior M⁻¹ gradient factor
+		scatterPass([&](size_t p) {
+			Kernel<D> k;
+			kernelOf(p, k);
+			if (!k.inside) return err.record(p, "has a position outside the grid or not finite: " + positionText(p));
+			const Real   m = P.mass[p], V = P.vol[p];
+			const Sym<D> sg = mat.forceStress(P, p);
+			Real         mv[D], mC[D][D], fe[D];
+			for (int a = 0; a < D; ++a) {
+				mv[a] = m * P.v[a][p];
+				for (int b = 0; b < D; ++b) mC[a][b] = m * P.C[a * D + b][p];
+				fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
+			}
+			if (!k.general) {
+				Real sgm[D][D];
+				sym2full(sg, sgm);
+				const NodeLanes P0 = nodeLanes<D>(m, m, mv, fe); // lanes: m, mw, momentum…, force…
+				NodeLanes       A[D];
+				for (int b = 0; b < D; ++b) {
+					Real ca[D], fa[D];
+					for (int a = 0; a < D; ++a) {
+						ca[a] = mC[a][b];
+						fa[a] = -V * Dinv * sgm[a][b]; // Eq. 21, f_int = −Σ V σ ∇ψ
+					}
+					A[b] = nodeLanes<D>(0, 0, ca, fa);
+				}
+				scatterAffine(grid, k, P0, A); // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
+				return;
+			}
+			Stencil<D> st;
+			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
+				const Real psi = st.psi[n];
+				nd.m += psi * m;      // Eq. 20
+				nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
+				Real sg_g[D];
+				stressTimesVector(sg, st.grad[n], sg_g);
+				for (int a = 0; a < D; ++a) {
+					Real mom = mv[a];
+					for (int b = 0; b < D; ++b) mom += mC[a][b] * dx[b];
+					nd.a[a] += psi * mom;                  // momentum of the affine velocity field (Eq. 16)
+					nd.b[a] += -V * sg_g[a] + psi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+				}
+			});
+		});
+	}
+
+	// ------------------------------------------------------------ G2P + MUSL remap: Eqs. 6–7, 16–17
+	// Particle velocity and its WLS gradient from the updated nodal velocities (lanes a), then the
+	// particle's local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m (lanes b).
+	void g2p(ErrorRecord& err)
+	{
+		auto& nodes = grid.nodes;
+		scatterPass([&](size_t p) {
+			Kernel<D> k;
+			kernelOf(p, k);
+			const Real m = P.mass[p];
+			Real       v[D] = {}, C[D][D] = {};
+			if (!k.general) {
+				gatherInterior<2>(grid, k, v, C); // Eqs. 6–7 from the updated velocities (lanes a)
+				storeVelocity(p, v, C);
+				NodeLanes H[D + 1]; // m h_p(x_i) = m (v + ∇v (x_i − x_p)) into lanes b
+				{
+					const Real zero[D] = {};
+					Real       mvv[D], mc[D];
+					for (int a = 0; a < D; ++a) mvv[a] = m * v[a];
+					H[D] = nodeLanes<D>(0, 0, zero, mvv);
+					for (int b = 0; b < D; ++b) {
+						for (int a = 0; a < D; ++a) mc[a] = m * C[a][b];
+						H[b] = nodeLanes<D>(0, 0, zero, mc);
+					}
+				}
+				scatterAffine(grid, k, H[D], H); // Eq. 16 numerator, Σ w m h_p(x_i)
+				return;
+			}
+			Stencil<D> st;
+			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			forStencil(nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
+				for (int a = 0; a < D; ++a) {
+					v[a] += st.psi[n] * nd.a[a];                                   // Eq. 6
+					for (int b = 0; b < D; ++b) C[a][b] += nd.a[a] * st.grad[n][b]; // Eq. 7
+				}
+			});
+			storeVelocity(p, v, C);
+			forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
+				const Real wm = st.w[n] * m;
+				for (int a = 0; a < D; ++a) {
+					Real h = v[a];
+					for (int b = 0; b < D; ++b) h += C[a][b] * dx[b];
+					nd.b[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x_p)
+				}
+			});
+		});
+	}
+
+	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (lanes b, Eq. 7). False if the WLS fit is singular.
+	bool velocityGradient(size_t p, Real (&L)[D][D]) const
+	{
+		Kernel<D> k;
+		kernelOf(p, k);
+		if (!k.general) {
+			Real v[D];
+			gatherInterior<2 + D>(grid, k, v, L);
+			return true;
+		}
+		Stencil<D> st;
+		if (!fillStencil(grid, offs, k, st)) return false;
+		forStencil(grid.nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
+			for (int a = 0; a < D; ++a)
+				for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];
+		});
+		return true;
+	}
+
+	std::string positionText(size_t p) const
+	{
+		std::string t = "(";
+		for (int a = 0; a < D; ++a) t += (a ? ", " : "") + fmtNum(P.x[a][p]);
+		return t + ") m";
+	}
+
+private:
+	void storeVelocity(size_t p, const Real (&v)[D], const Real (&C)[D][D])
+	{
+		for (int a = 0; a < D; ++a) {
+			P.v[a][p] = v[a];
+			for (int b = 0; b < D; ++b) P.C[a * D + b][p] = C[a][b];
+		}
+	}
+};
+
+} // namespace mpm
