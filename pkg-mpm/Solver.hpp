@@ -209,6 +209,7 @@ public:
 	}
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
 	Real maxSpeed() const { return vmax; }
+	const BlockSchedule<D>& schedule() const { return sched; }
 	// Python calls this after writing particle views: re-sort and re-validate before the next step.
 	void requestSort() { needSort = needCheck = true; }
 
