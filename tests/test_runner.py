@@ -24,7 +24,7 @@ def test_end_time_and_max_steps():
     s, dt = block()
     res = runner.run(s, end_time=100.5 * dt)
     assert res.reason == "end_time" and res.steps == 101 and s.steps == 101
-    res = runner.run(s, end_time=1.0, max_steps=17)          # max_steps counts the steps of this call
+    res = runner.run(s, end_time=np.float64(1.0), max_steps=np.int64(17))   # counts the steps of this call
     assert res.reason == "max_steps" and res.steps == 17 and s.steps == 118
     assert runner.run(s, end_time=s.time).steps == 0         # already there: no step
 
@@ -125,7 +125,7 @@ def test_vtu_series_index_and_data(tmp_path):
                                       (dict(max_steps=2.5), "max_steps"), (dict(stop=3), "stop"),
                                       (dict(every=[(0.0, print)]), "period"), (dict(every=[print]), "every"),
                                       (dict(outputs=[print]), "outputs"), (dict(on_interrupt="ignore"), "on_interrupt"),
-                                      (dict(progress=-1), "progress")])
+                                      (dict(progress=-1), "progress"), (dict(), "never end")])
 def test_bad_arguments(kw, name):
     s, _ = block()
     with pytest.raises(ValueError, match=name):

@@ -26,6 +26,7 @@ reason "interrupted" (``on_interrupt="return"``). A solver error (``MpmSimulatio
 at once, without the ``at_end`` outputs, since the state is then half-updated.
 """
 import math
+import numbers
 import time as _time
 
 from .progress import Progress
@@ -57,13 +58,13 @@ class Output:
     def __init__(self, callback, period=None, steps=None, times=(), at_start=False, at_end=False):
         if not callable(callback):
             raise ValueError(f"callback = {callback!r} must be callable as f(solver)")
-        if period is not None and not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
+        if period is not None and not (_real(period) and period > 0):
             raise ValueError(f"period = {period!r} s must be a finite number > 0 (simulated seconds)")
-        if steps is not None and not (isinstance(steps, int) and not isinstance(steps, bool) and steps >= 1):
+        if steps is not None and not (_integer(steps) and steps >= 1):
             raise ValueError(f"steps = {steps!r} must be an integer ≥ 1")
+        if not all(_real(t) for t in times):
+            raise ValueError(f"times = {list(times)} must be finite simulated times [s]")
         times = [float(t) for t in times]
-        if not all(math.isfinite(t) for t in times):
-            raise ValueError(f"times = {times} must be finite simulated times [s]")
         if period is None and steps is None and not times and not at_start and not at_end:
             raise ValueError("Output needs at least one of period, steps, times, at_start, at_end")
         self.callback, self.period, self.steps = callback, period, steps
@@ -90,6 +91,14 @@ class Output:
         self._last_time = solver.time
         self._called_at = solver.steps
         return self.callback(solver) is STOP
+
+
+def _real(x):
+    return isinstance(x, numbers.Real) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _integer(x):
+    return isinstance(x, numbers.Integral) and not isinstance(x, bool)
 
 
 def _reached(t, target):
@@ -135,9 +144,9 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
     before_step: f(solver) called before each step (e.g. to take ``stableDt()`` of the state before it).
     on_interrupt: "raise" (re-raise KeyboardInterrupt after the at_end outputs) or "return".
     Returns a RunResult."""
-    if end_time is not None and not (isinstance(end_time, (int, float)) and math.isfinite(end_time)):
+    if end_time is not None and not _real(end_time):
         raise ValueError(f"end_time = {end_time!r} s must be a finite number (absolute simulated time) or None")
-    if max_steps is not None and not (isinstance(max_steps, int) and not isinstance(max_steps, bool) and max_steps >= 0):
+    if max_steps is not None and not (_integer(max_steps) and max_steps >= 0):
         raise ValueError(f"max_steps = {max_steps!r} must be an integer ≥ 0 or None")
     if stop is not None and not callable(stop):
         raise ValueError(f"stop = {stop!r} must be callable as stop(solver) -> bool")
@@ -150,10 +159,12 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         prog = None
     elif isinstance(progress, Progress):
         prog = progress
-    elif isinstance(progress, (int, float)) and progress > 0:
+    elif _real(progress) and progress > 0:
         prog = Progress(end_time, label, float(progress), total_steps=max_steps)
     else:
         raise ValueError(f"progress = {progress!r} must be None, wall seconds > 0 or a Progress")
+    if end_time is None and max_steps is None and stop is None and not outs:
+        raise ValueError("run would never end: give end_time, max_steps, stop or an output that returns STOP")
 
     wall0 = _time.time()
     taken, reason = 0, None
