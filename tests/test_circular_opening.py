@@ -57,12 +57,12 @@ def test_kirsch_equilibrium():
 
 
 # ---------------------------------------------------------------- boundary load of the script
-@pytest.mark.parametrize("mode, bound", [("consistent", 1e-6), ("outer-row", None)])
-def test_far_field_load_keeps_intact_block_in_equilibrium(mode, bound):
+@pytest.mark.parametrize("mode, bound, ppc", [("consistent", 1e-6, 2), ("consistent", 1e-6, 3), ("outer-row", None, 2)])
+def test_far_field_load_keeps_intact_block_in_equilibrium(mode, bound, ppc):
     """An intact block with the in-situ stress and the far-field load must stay at rest with the stress
     unchanged. The consistent row weights achieve that to round-off; the traction on the outermost row
     alone does not (it roughly halves the stress of that row), which is why the script spreads it."""
-    l, L, ppc = 0.04, 0.64, 2
+    l, L = 0.04, 0.64
     s = ym.make_solver((0, 0), (L, L), l, margin=2)
     mat = rocks.granite()
     ym.add_region(s, mat, (0, 0), (L, L), ppc=ppc)
@@ -79,10 +79,9 @@ def test_far_field_load_keeps_intact_block_in_equilibrium(mode, bound):
         assert dev > 0.1
 
 
-def test_consistent_row_weights_sum_to_one():
-    for ppc in (2, 3, 4):
-        assert ym.consistent_row_weights(ppc).sum() == pytest.approx(1.0)
-    with pytest.raises(ValueError, match="ppc = 1"):
+def test_consistent_row_weights_refuse_one_particle_per_cell():
+    # (Σβ = 1 holds by the normalisation; the weights are checked by the equilibrium test above.)
+    with pytest.raises(ValueError, match=r"ppc .*consistent=False.* = 1 must be an integer in \[2, 16\]"):
         ym.consistent_row_weights(1)
 
 
@@ -113,7 +112,6 @@ def test_small_opening_against_kirsch(tmp_path):
     assert abs(summary["hoop_stress_theta90_MPa"] - 50.0) < 0.06 * 50.0
     assert abs(summary["hoop_stress_theta0_MPa"] - 10.0) < 0.25 * 10.0
     conv = summary["convergence"]
-    assert [r["grid_spacing_m"] for r in conv] == [0.08, 0.04]
     assert conv[1]["l2_rel_error_max"] < conv[0]["l2_rel_error_max"]
     # every particle of the 2.4 m block minus the hole: 60 × 60 cells × 4, less those whose centres lie in r < a
     x = (np.arange(120) + 0.5) * 0.02 + 1.3

@@ -19,7 +19,6 @@ def test_momentum_conserved_without_boundaries():
         s.step()
     drift = np.abs(total_momentum(s) - p0).max() / scale
     assert drift < 1e-12, drift
-    assert s.steps == 300
 
 
 def _standing_wave_period(cells_x):
@@ -68,7 +67,6 @@ def test_energy_bounded_over_1e4_steps_of_free_vibration():
     for _ in range(100):
         s.run(100)
         e.append(s.kineticEnergy() + s.elasticEnergy())
-    assert s.steps == 10_000
     e = np.array(e)
     assert np.all(np.isfinite(e))
     assert e.max() <= 1.03 * e0, e.max() / e0   # bounded: no energy growth

@@ -26,7 +26,8 @@ def test_case_is_stable(name):
     assert r["energy_bounded"] and r["max_energy_ratio"] <= 1 + st.ENERGY_TOL, r["max_energy_ratio"]
     # energy actually entered and stayed: the ratio is not trivially zero
     assert r["max_energy_ratio"] > 0.5, r["max_energy_ratio"]
-    assert r["dt_within_limit"] and r["max_dt_over_stable"] <= 1 + 1e-12, r["max_dt_over_stable"]
+    # Δt against C·l/(v_c + max‖v‖) recomputed from the particle arrays (not the solver's stableDt)
+    assert r["dt_within_limit"] and r["max_dt_over_stable"] <= 1 + 1e-9, r["max_dt_over_stable"]
     # at C = 0.5 the step stays within the paper's Δt ≤ l/(v_c + |v|) even with the post-step velocities
     assert r["max_dt_over_paper_limit_after_step"] <= 1.0, r["max_dt_over_paper_limit_after_step"]
     assert np.all(np.isfinite(h["total"])) and np.all(np.isfinite(h["input"]))
