@@ -85,7 +85,7 @@ def build_paper(name):
         s, _ = cases.line_crack(5.0, 0.02, rocks.granite_dpgk(), 75e6, ramp=2e-4, damping=0.05)
         return s
     h = 1e-3
-    s = cases.arch_tunnel(h, rocks.pan2020_sandstone())   # slip walls left, right, bottom
+    s = cases.arch_tunnel_specimen(h, rocks.pan2020_sandstone())   # slip walls left, right, bottom
     top = ym.boundary_particles(s, 1, +1)
     ym.apply_traction(s, top, (0.0, -60e6), h / 2)
     s.tractionRampTime = 5e-3

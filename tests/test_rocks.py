@@ -47,7 +47,7 @@ def test_overrides_replace_one_value_and_refuse_unknown_names():
 def test_arch_tunnel_geometry():
     """Particles missing from the 150 mm square = the arch opening's area, 40 × 25 mm + π·20²/2 mm²."""
     h = 1e-3
-    s = cases.arch_tunnel(h, rocks.pan2020_sandstone())
+    s = cases.arch_tunnel_specimen(h, rocks.pan2020_sandstone())
     missing = (0.15 / (h / 2)) ** 2 - s.numParticles
     assert missing * (h / 2) ** 2 == pytest.approx(0.04 * 0.025 + math.pi * 0.02 ** 2 / 2, rel=0.01)
     pos = ym.get(s, "pos")

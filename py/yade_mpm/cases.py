@@ -4,14 +4,18 @@ scenes here and keep only their command line and analysis.
     circular_opening(spacing, ...)   paper Sec. 3.1: holed block under biaxial in-situ stress
     line_crack(size, spacing, ...)   paper Sec. 3.2: pressurised line ("penny-shaped") crack
     arch_tunnel_holes(...)           paper Sec. 4: the arch-shaped tunnel opening (geometry only)
-    arch_tunnel(spacing, ...)        the tunnel specimen with its opening and slip walls (no top load)
+    tunnel_flaw(...)                 paper Sec. 4: the 60 × 2 mm flaw left of the tunnel (geometry only)
+    arch_tunnel_specimen(spacing, ...)  the tunnel specimen with its opening and slip walls (no top load)
+    arch_tunnel(case, spacing, ...)  paper Sec. 4 + grout: the full scene with the YADE platen (and filler)
 
 Quantities are SI; stresses are tension positive inside the solver.
 """
+import math
+
 import numpy as np
 
 from . import rocks
-from .geometry import Box, Circle
+from .geometry import Box, Circle, rotated_rectangle
 from .scene import add_region, apply_face_traction, apply_traction, get, make_solver, set_initial_stress
 
 # ------------------------------------------------------------------------------------------------
@@ -108,9 +112,10 @@ def arch_tunnel_holes(width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect=TUNNEL_RECT, 
     return [Box((cx - w / 2, floor), (cx + w / 2, floor + hgt)), Circle((cx, floor + hgt), radius)]
 
 
-def arch_tunnel(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, walls=("left", "right", "bottom")):
-    """The tunnel specimen [0, width]² with the arch opening, free-slip walls on `walls` (the paper's
-    four sides minus the loaded top, where the caller puts a platen or a traction).
+def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, walls=("left", "right", "bottom"),
+                         holes=()):
+    """The tunnel specimen [0, width]² with the arch opening (and further `holes`), free-slip walls on
+    `walls` (the paper's four sides minus the loaded top, where the caller puts a platen or a traction).
     material: default ``rocks.pan2020_sandstone()``. Returns the solver."""
     planes = {"left": (0, -1, 0.0), "right": (0, 1, width), "bottom": (1, -1, 0.0), "top": (1, 1, width)}
     bad = [w for w in walls if w not in planes]
@@ -118,8 +123,139 @@ def arch_tunnel(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floor=TUNNEL_
         raise ValueError(f"walls: unknown {bad}; allowed {sorted(planes)}")
     mat = material or rocks.pan2020_sandstone()
     s = make_solver((0, 0), (width, width), spacing, margin=2)
-    add_region(s, mat, (0, 0), (width, width), ppc=ppc, holes=arch_tunnel_holes(width, floor))
+    add_region(s, mat, (0, 0), (width, width), ppc=ppc, holes=list(arch_tunnel_holes(width, floor)) + list(holes))
     for w in walls:
         axis, side, pos = planes[w]
         s.addBoundaryPlane(axis, side, pos, "slip")
     return s
+
+
+# The flaw of Figs. 16b, c. The paper gives its size (60 mm × 2 mm, "adjacent to the tunnel", on its
+# left) but not its position or angle; they are chosen from the description of Fig. 19 (the flaw
+# hinders the load path from the top to the left waist; stress concentrates at the flaw toe, next to
+# the left spandrel; a crack links the toe to the tunnel corner) — see doc/tunnel.md. One place only:
+FLAW_LENGTH = 0.06                 # [m]
+FLAW_WIDTH = 0.002                 # [m]
+FLAW_ANGLE = math.radians(60.0)    # inclination to the horizontal [rad]; rises to the left, away from the tunnel
+FLAW_TOE_GAP = 0.010               # horizontal rock bridge from the toe (lower end) to the left wall [m]
+FLAW_TOE = (TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - FLAW_TOE_GAP, TUNNEL_FLOOR + TUNNEL_RECT[1])  # at spandrel height [m]
+
+# Loading and contact of Sec. 4
+PLATEN_SPEED = 0.1                 # downward velocity of the rigid top platen [m/s]
+TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displacement)
+PLATEN_FRICTION = 0.0              # platen–rock μ_con [-]: the paper's free-slip top
+FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
+TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
+
+
+def tunnel_flaw(toe=FLAW_TOE, length=FLAW_LENGTH, width=FLAW_WIDTH, angle=FLAW_ANGLE):
+    """The flaw as a dict: toe (lower end, centre of the short side) and tip (upper end) [m], centre,
+    unit direction from toe to tip, normal, length, width [m], angle [rad] and the Polygon."""
+    u = np.array([-math.cos(angle), math.sin(angle)])        # from the toe up and to the left
+    toe = np.asarray(toe, float)
+    center = toe + 0.5 * length * u
+    return dict(toe=toe, tip=toe + length * u, center=center, direction=u, normal=np.array([-u[1], u[0]]),
+                length=length, width=width, angle=angle,
+                polygon=rotated_rectangle(center, length, width, math.atan2(u[1], u[0])))
+
+
+def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
+                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, label="mpm"):
+    """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
+    arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
+    DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
+      case "intact"       no flaw,
+           "open_flaw"    the flaw (``tunnel_flaw()``) cut out,
+           "filled_flaw"  the flaw cut out and filled by a free rigid YADE Box (PTS contact, μ = filler_friction),
+           "grout_flaw"   the flaw filled with particles of the elastic `grout` (default ``rocks.cement_grout()``),
+                          bonded to the rock through the shared grid.
+    spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``).
+    O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
+    Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
+    engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m])."""
+    if case not in TUNNEL_CASES:
+        raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
+    if not (isinstance(spacing, (int, float)) and 0 < spacing <= FLAW_WIDTH * 2.5):
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {FLAW_WIDTH * 2.5}] m (the flaw, {FLAW_WIDTH * 1e3:g} mm wide, "
+                         "must hold at least two particle rows)")
+    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
+        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    from yade import O, utils
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+    from .bodies import RigidBodies
+    from .engine import MpmEngine
+
+    W = TUNNEL_WIDTH
+    flaw = tunnel_flaw() if case != "intact" else None
+    rock = material or rocks.pan2020_sandstone()
+    holes = [flaw["polygon"]] if case in ("open_flaw", "filled_flaw") else []
+    s = arch_tunnel_specimen(spacing, rock, ppc, holes=holes)
+    if case == "grout_flaw":
+        add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
+    O.reset()
+    thick = 0.5                                    # YADE box half-extent along z: 1 m thick, the 2D unit slice
+    hp = 5 * spacing                               # platen half-height
+    platen = O.bodies.append(utils.box((W / 2, W + hp, 0), (0.6 * W, hp, thick), fixed=False))
+    O.bodies[platen].state.blockedDOFs = "xyzXYZ"
+    O.bodies[platen].state.vel = (0, -platen_speed, 0)
+    rb = RigidBodies(s)
+    rb.add(platen, mu=platen_friction)
+    filler = None
+    if case == "filled_flaw":
+        hl, hw = _filler_half_sizes(s, flaw, ppc)
+        ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
+        from minieigen import Quaternion, Vector3
+        filler = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, thick),
+                                           orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False))
+        O.bodies[filler].state.blockedDOFs = "zXY"  # in the plane: x, y, rotation about z
+        rb.add(filler, mu=filler_friction)
+    eng = MpmEngine(s, label=label, bodies=rb)
+    O.engines = [ForceResetter(), eng.runner(), NewtonIntegrator(damping=0.0, gravity=(0, 0, 0))]
+    O.dt = 1.0                                     # lowered to the MPM stable step by the engine
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W)
+
+
+def _filler_half_sizes(solver, flaw, ppc):
+    """Half length and half width [m] of a rigid filler that fills the flaw cut from the particle lattice
+    without overlapping any particle's cell (the PTS detection distance d0 is half the particle edge):
+    the cut is jagged on the lattice, so the box is the flaw shrunk to the nearest particle cell faces."""
+    x = get(solver, "pos") - flaw["center"]
+    d0 = 0.5 * solver.spacing / ppc
+    along, across = x @ flaw["direction"], x @ flaw["normal"]
+    band = np.abs(along) < 0.5 * flaw["length"]
+    hw = min(0.5 * flaw["width"], np.min(np.abs(across[band])) - d0)
+    side = np.abs(across) < hw + d0
+    hl = min(0.5 * flaw["length"], np.min(np.abs(along[side])) - d0)
+    if not (hw > 0 and hl > 0):
+        raise ValueError("the flaw holds no room for a filler at this grid spacing")
+    return hl, hw
+
+
+def tunnel_location(point, flaw=None):
+    """Name of the part of the tunnel (or flaw) nearest a point [m]: "floor", "left/right corner"
+    (where the walls meet the floor), "left/right wall" (the waist), "left/right spandrel" (the arch
+    shoulders, more than 30° from the vertical), "crown", "flaw toe", "flaw tip", "flaw face", or
+    "rock away from the opening" (more than 10 mm from the opening and the flaw)."""
+    x, y = float(point[0]), float(point[1])
+    cx, floor = TUNNEL_WIDTH / 2, TUNNEL_FLOOR
+    hw, hr = TUNNEL_RECT[0] / 2, TUNNEL_RECT[1]
+    if flaw is not None:
+        r = np.array([x, y]) - flaw["toe"]
+        s = float(np.clip(r @ flaw["direction"], 0, flaw["length"]))
+        d_flaw = np.linalg.norm(r - s * flaw["direction"])
+        if d_flaw < 0.005:
+            return "flaw toe" if s < 0.2 * flaw["length"] else ("flaw tip" if s > 0.8 * flaw["length"] else "flaw face")
+    # distance to the opening (rectangle ∪ half disc), 0 inside
+    dx = max(abs(x - cx) - hw, 0.0)
+    dy = max(floor - y, y - (floor + hr), 0.0)
+    d_rect = math.hypot(dx, dy)
+    d_arch = max(math.hypot(x - cx, y - (floor + hr)) - TUNNEL_RADIUS, 0.0) if y >= floor + hr else d_rect
+    if min(d_rect, d_arch) > 0.010:
+        return "rock away from the opening"
+    side = "left" if x < cx else "right"
+    if y >= floor + hr - 0.003:
+        theta = math.degrees(math.atan2(abs(x - cx), max(y - (floor + hr), 1e-12)))
+        return "crown" if theta < 30 else f"{side} spandrel"
+    if y < floor + 0.005:
+        return f"{side} corner" if abs(x - cx) > hw - 0.003 else "floor"
+    return f"{side} wall"

@@ -221,22 +221,26 @@ def _resolve_solvers(solvers, O):
     raise ValueError("solvers must be None (the MpmEngines in O.engines), a Solver2D/3D or a non-empty {name: solver} dict")
 
 
-def save(path, solvers=None, yade=None, meta=None):
+def save(path, solvers=None, yade=None, meta=None, extra=None):
     """Write a checkpoint of the whole simulation to `path` (atomically: a crash while writing leaves
     the previous file intact). solvers: None = the solvers of the MpmEngines in O.engines, or a solver,
     or {name: solver}; yade: include the YADE scene (None = when yade is imported and O has bodies or
     engines); meta: a JSON-able dict stored alongside (e.g. the case and grid spacing; ``load`` with
-    the same meta refuses a checkpoint with another one). Call between steps (not from inside a
-    PyRunner). Returns the number of bytes written."""
+    the same meta refuses a checkpoint with another one); extra: JSON-able state of the calling script
+    (e.g. the curve recorded so far), returned by ``load`` as ``header["extra"]``. Call between steps
+    (not from inside a PyRunner). Returns the number of bytes written."""
     O = _yade_O()
     with_yade = (O is not None and (len(O.bodies) > 0 or len(O.engines) > 0)) if yade is None else bool(yade)
     if with_yade and O is None:
         raise ValueError("yade=True but yade is not imported")
     sol = _resolve_solvers(solvers, O if with_yade else None)
-    if meta is not None:
-        json.dumps(meta)                           # must be JSON-able: fail before writing anything
+    for name, v in (("meta", meta), ("extra", extra)):
+        try:
+            json.dumps(v)                          # must be JSON-able: fail before writing anything
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"{name} must be JSON-serialisable (dicts, lists, numbers, strings): {e}") from None
     arrays, header = {}, {"format": FORMAT, "build": build_id(), "written": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
-                          "meta": meta, "solvers": {}, "yade": None}
+                          "meta": meta, "extra": extra, "solvers": {}, "yade": None}
     for name, s in sol.items():
         header["solvers"][name] = solver_fingerprint(s)
         for k, v in _solver_state(s).items():
@@ -408,15 +412,17 @@ class Checkpointer:
                     ck.save(); write_outputs(); break
 
     every_steps: steps between checkpoints (None = not by steps); every_minutes: wall minutes
-    between checkpoints (None = not by time). save() passes `solvers`, `meta` to ``save``."""
+    between checkpoints (None = not by time). save() passes `solvers`, `meta` and `extra()` (a
+    function returning the script's JSON-able state, or None) to ``save``."""
 
-    def __init__(self, path, every_steps=None, every_minutes=None, solvers=None, meta=None, verbose=True):
+    def __init__(self, path, every_steps=None, every_minutes=None, solvers=None, meta=None, extra=None, verbose=True):
         if every_steps is not None and not (int(every_steps) == every_steps and every_steps >= 1):
             raise ValueError(f"every_steps = {every_steps} must be an integer ≥ 1 (or None)")
         if every_minutes is not None and not (np.isfinite(every_minutes) and every_minutes > 0):
             raise ValueError(f"every_minutes = {every_minutes} must be > 0 (or None)")
         self.path, self.every_steps, self.every_minutes = path, every_steps, every_minutes
         self.solvers, self.meta, self.verbose = solvers, meta, verbose
+        self.extra = extra                        # None or f() -> JSON-able script state saved with each checkpoint
         self.last_step, self.last_wall = None, time.time()
         self.stop_requested, self.signal_name = False, None
         self.saved = 0
@@ -436,12 +442,24 @@ class Checkpointer:
         return False
 
     def save(self, step=None):
-        nbytes = save(self.path, solvers=self.solvers, meta=self.meta)
+        nbytes = save(self.path, solvers=self.solvers, meta=self.meta, extra=self.extra() if self.extra else None)
         self.last_step = step if step is not None else self.last_step
         self.last_wall = time.time()
         self.saved += 1
         if self.verbose:
             print(f"[checkpoint] {self.path} ({nbytes / 1e6:.1f} MB)" + (f" at step {step}" if step is not None else ""), flush=True)
+
+    def output(self, steps=50):
+        """A ``runner.Output`` that checks every `steps` steps: writes a checkpoint when one is due and
+        ends the run (``runner.STOP``, so the run's at_end outputs are written) after SIGINT/SIGTERM."""
+        from . import runner
+
+        def check(solver):
+            if self.stop_requested:
+                return runner.STOP
+            self.tick(solver.steps)
+            return None
+        return runner.Output(check, steps=steps)
 
     def signals(self):
         """Context manager: SIGINT and SIGTERM set `stop_requested` (the loop then saves and stops)

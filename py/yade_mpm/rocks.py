@@ -17,11 +17,16 @@ Raw dicts (keyword arguments of ``ElasticMat`` / ``DpGkMat``; SI units, angles i
 ``PAN2020_SANDSTONE``  sandstone of the tunnel tests of Pan et al. (2020b), paper Sec. 4:
                        E = 18.4 GPa, ν = 0.12, ρ = 2364 kg/m³, φ = 39°, ψ = 9.75°, c₀ = 25 MPa,
                        with ``RAYMOND2019_DAMAGE``
+``CEMENT_GROUT``       hardened cement grout (w/c = 1 by weight), elastic, for the grout-filled flaw
+                       of the tunnel (beyond the paper): E = 10.8 GPa (secant E50), ν = 0.22,
+                       ρ = 1500 kg/m³ — Zhu, Zhang, Zhang & Hui (2018), Comparative study of soil
+                       grouting with cement slurry and cement–sodium silicate slurry, Adv. Mater. Sci.
+                       Eng. 2018:1893195, doi:10.1155/2018/1893195, Table 3 (UCS 5.9 MPa)
 =====================  ==========================================================================
 
 Material constructors (keyword overrides replace single values, e.g. ``pan2020_sandstone(damage=False)``;
 unknown names and out-of-range values raise before any work):
-``granite()`` (ElasticMat), ``granite_dpgk()``, ``miao2018_sandstone()``, ``pan2020_sandstone()`` (DpGkMat),
+``granite()``, ``cement_grout()`` (ElasticMat), ``granite_dpgk()``, ``miao2018_sandstone()``, ``pan2020_sandstone()`` (DpGkMat),
 and ``elastic(params)`` for the elastic part of any set.
 """
 import math
@@ -48,11 +53,15 @@ MIAO2018_SANDSTONE = dict(young=9.87e9, poisson=0.22, density=2520.0, frictionAn
 PAN2020_SANDSTONE = dict(young=18.4e9, poisson=0.12, density=2364.0, frictionAngle=math.radians(39.0),
                          dilationAngle=math.radians(9.75), cohesion=25.0e6, **RAYMOND2019_DAMAGE)
 
+# Zhu et al. (2018), Table 3: hardened cement slurry, w/c = 1 (the grout-filled flaw of the tunnel)
+CEMENT_GROUT = dict(young=10.8e9, poisson=0.22, density=1500.0)
+
 SETS = {
     "granite": (GRANITE, "paper Sec. 3.1, circular opening (elastic)"),
     "granite_dpgk": (GRANITE_DPGK, "paper Sec. 3.2, penny-shaped crack (DP-GK)"),
     "miao2018_sandstone": (MIAO2018_SANDSTONE, "Miao et al. 2018 / Raymond et al. 2019, paper Sec. 3.3 (DP-GK)"),
     "pan2020_sandstone": (PAN2020_SANDSTONE, "Pan et al. 2020b / Raymond et al. 2019, paper Sec. 4 (DP-GK)"),
+    "cement_grout": (CEMENT_GROUT, "Zhu et al. 2018, hardened cement grout w/c = 1 (elastic), tunnel grout_flaw"),
 }
 
 
@@ -79,3 +88,8 @@ def miao2018_sandstone(**overrides):
 def pan2020_sandstone(**overrides):
     """Sandstone of Pan et al. 2020b with Raymond et al. 2019 damage, paper Sec. 4 (DpGkMat)."""
     return DpGkMat(**dict(PAN2020_SANDSTONE, **overrides))
+
+
+def cement_grout(**overrides):
+    """Hardened cement grout of Zhu et al. 2018 (ElasticMat), the filling of the tunnel's grout_flaw case."""
+    return ElasticMat(**dict(CEMENT_GROUT, **overrides))

@@ -135,7 +135,7 @@ def _outputs(every, outputs):
 
 
 def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=None, every=(), outputs=(),
-        before_step=None, on_interrupt="raise"):
+        before_step=None, on_interrupt="raise", advance=None):
     """Step `solver` until simulated time ≥ end_time [s] (absolute solver time), or `max_steps` steps of
     this call, or ``stop(solver)`` is true after a step, or an output callback returns STOP.
 
@@ -143,6 +143,8 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
     every: [(period [s], callback), …] or Output objects; outputs: Output objects (see Output).
     before_step: f(solver) called before each step (e.g. to take ``stableDt()`` of the state before it).
     on_interrupt: "raise" (re-raise KeyboardInterrupt after the at_end outputs) or "return".
+    advance: f() that advances the whole simulation by one step (default ``solver.step``); YADE's
+    ``O.step`` when the solver runs inside O.engines through an MpmEngine (rigid bodies, DEM).
     Returns a RunResult."""
     if end_time is not None and not _real(end_time):
         raise ValueError(f"end_time = {end_time!r} s must be a finite number (absolute simulated time) or None")
@@ -154,6 +156,9 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         raise ValueError(f"before_step = {before_step!r} must be callable as f(solver)")
     if on_interrupt not in ("raise", "return"):
         raise ValueError(f"on_interrupt = {on_interrupt!r} must be 'raise' or 'return'")
+    if advance is not None and not callable(advance):
+        raise ValueError(f"advance = {advance!r} must be callable as f() (one step of the simulation)")
+    step = advance if advance is not None else solver.step
     outs = _outputs(every, outputs)
     if progress is None or progress is False:
         prog = None
@@ -185,7 +190,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
                 break
             if before_step is not None:
                 before_step(solver)
-            solver.step()
+            step()
             taken += 1
             if prog is not None:
                 prog.update(solver.steps, solver.time)
