@@ -60,8 +60,8 @@ def parse():
     if a.paper and a.spacing is not None:
         ap.error("--paper sets the spacing; do not also give --spacing")
     a.spacing = PAPER_SPACING if a.paper else (a.spacing or DEFAULT_SPACING)
-    if not (0 < a.spacing <= 2.5e-3):
-        ap.error(f"--spacing = {a.spacing} m must be in (0, 0.0025] (two particle rows across the 2 mm flaw)")
+    if not (0 < a.spacing <= cases.TUNNEL_MAX_SPACING):
+        ap.error(f"--spacing = {a.spacing} m must be in (0, {cases.TUNNEL_MAX_SPACING}] (the 2 mm flaw must cut a full particle row)")
     if not (0 < a.end_time <= 0.1):
         ap.error(f"--end-time = {a.end_time} s must be in (0, 0.1]")
     if not (0 < a.courant <= 1):
@@ -102,7 +102,7 @@ class CaseRun:
         self.ppc = 2
         self.dp = s.spacing / self.ppc
         self.x0 = ym.get(s, "pos")                             # initial positions by id
-        self.lattice = analysis.Lattice(self.x0, self.dp)
+        self.lattice = analysis.Lattice(self.x0, self.dp, origin=(0, 0))
         self.rock = self._rock_mask()
         from yade import O
         self.platen_y0 = O.bodies[self.bodies["platen"]].state.pos[1]
@@ -155,15 +155,13 @@ class CaseRun:
     def snapshot(self, solver):
         """Fields for the pictures and the analysis at 8, 12, 20 ms (id order), kept in an .npz."""
         o = ym.id_order(solver)
-        t_ms = solver.time * 1e3
-        target = min(SNAPSHOTS_MS, key=lambda t: abs(t - t_ms))
         f = dict(time=solver.time, displacement=self.displacement(), pos=ym.get(solver, "pos", o),
                  damage=ym.get(solver, "damage", o), epsP=ym.get(solver, "plastic_strain", o),
                  smax=ym.get(solver, "max_principal_stress", o), mass=ym.get(solver, "mass", o))
-        path = os.path.join(self.dir, f"snapshot_{int(round(target)):02d}ms.npz")
-        np.savez_compressed(path, **f)
-        if path not in self.state["snapshots"]:
-            self.state["snapshots"].append(path)
+        name = f"snapshot_{int(round(solver.time * 1e3)):02d}ms.npz"      # 08ms, 12ms, 20ms (or where a run stopped)
+        np.savez_compressed(os.path.join(self.dir, name), **f)
+        if name not in self.state["snapshots"]:
+            self.state["snapshots"].append(name)
 
     def vtu_fields(self, solver):
         pos, fields = output.particle_fields(solver)
@@ -181,7 +179,8 @@ class CaseRun:
             self.state = h["extra"]
             resumed = True
             print(f"[{self.case}] resumed at t = {s.time * 1e3:.3f} ms (step {s.steps})", flush=True)
-        if self.state["done"]:
+        if resumed and s.time >= a.end_time * (1 - runner.TIME_TOL):   # finished (a larger --end-time continues it)
+            self.state["done"] = True
             return self
         n = s.numParticles
         print(f"[{self.case}] {n} particles, l = {s.spacing * 1e3:g} mm, Δt ≈ {s.stableDt() * 1e6:.3f} µs, "
@@ -203,6 +202,7 @@ class CaseRun:
         self.state["wall"] += time.time() - wall0
         self.state["steps_run"] += s.steps - steps0
         self.state["done"] = res.reason == "end_time"
+        self.state["final_displacement"] = self.displacement()
         ck.save(s.steps)                                      # the last state: resumable, or the finished run
         if not self.state["done"]:
             print(f"[{self.case}] stopped at t = {s.time * 1e3:.3f} ms ({ck.signal_name or res.reason}); "
@@ -219,9 +219,9 @@ class CaseRun:
         holes = cases.arch_tunnel_holes()
         opening = lambda p: np.any([h.contains(p) for h in holes], axis=0)
         snaps = {}
-        for path in st["snapshots"]:
-            with np.load(path) as z:
-                snaps[os.path.basename(path)[9:13]] = {k: z[k] for k in z.files}
+        for name in st["snapshots"]:
+            with np.load(os.path.join(self.dir, name)) as z:
+                snaps[name[9:13]] = {k: z[k] for k in z.files}
         res = {"snapshots": {}}
         for key, f in sorted(snaps.items()):
             failed = self.rock & ((f["damage"] >= 1.0) | (f["epsP"] >= soft_end))
@@ -232,6 +232,15 @@ class CaseRun:
                 b["side"] = "left" if b["centroid"][0] < cx else "right"
                 b["location"] = cases.tunnel_location(b["centroid"], self.bodies["flaw"])
             surf = sp["mask"] & failed
+            toe = {}
+            fl = self.bodies["flaw"]
+            if fl is not None:                                  # the failed zone grown from the flaw toe (Fig. 19)
+                near_toe = self.rock & (np.hypot(*(self.x0 - fl["toe"]).T) < 4e-3)
+                link = analysis.clusters_touching(failed, self.lattice, near_toe & failed)
+                reach = link & analysis.opening_surface(self.lattice, opening)
+                toe = dict(toe_damaged=int(np.count_nonzero(near_toe & (f["damage"] >= 1))),
+                           toe_softened=int(np.count_nonzero(near_toe & shear)),
+                           toe_link_to_opening=self._where(self.x0[reach]) if reach.any() else None)
             res["snapshots"][key] = dict(
                 time_ms=float(f["time"] * 1e3), displacement_mm=float(f["displacement"] * 1e3),
                 symmetry_damage=analysis.mirror_symmetry(np.where(self.rock, f["damage"], 0), self.lattice, cx),
@@ -240,7 +249,7 @@ class CaseRun:
                 spalled_area_mm2=sp["area"] * 1e6, spalled_mass_kg_per_m=sp["mass"], spalled_particles=int(sp["mask"].sum()),
                 spalled_fragments=sp["fragments"],
                 spalling_at=self._where(self.x0[surf]) if surf.any() else None,
-                bands=bands[:6])
+                bands=bands[:6], **toe)
             f["spalled"] = sp["mask"]
         self.snaps, self.result = snaps, res
         return res
@@ -248,10 +257,10 @@ class CaseRun:
     def summary_entry(self):
         st, s = self.state, self.solver
         curve = np.array(st["curve"]) if st["curve"] else np.zeros((0, 3))
-        d_end = float(curve[-1, 1]) if len(curve) else 0.0
+        d_end = st.get("final_displacement", 0.0)
         at = []
         if len(curve):
-            for k in range(int(math.floor(d_end * 1e3 / CURVE_STEP_MM + 1e-9)) + 1):
+            for k in range(int(math.floor(curve[-1, 1] * 1e3 / CURVE_STEP_MM + 1e-9)) + 1):
                 dmm = round(k * CURVE_STEP_MM, 10)
                 at.append({"displacement_mm": dmm, "stress_MPa": float(np.interp(dmm * 1e-3, curve[:, 1], curve[:, 2]) / 1e6)})
         snap = self.result["snapshots"]
@@ -323,7 +332,9 @@ class CaseRun:
                      f"ε̄p {_fmt(i['symmetry_plastic'])}; D = 1 in {100 * i['damaged_fraction']:.1f} %, softened {100 * i['softened_fraction']:.1f} % "
                      f"of the rock; shear bands (inclination to the horizontal): {bands}; spalling at the opening surface: "
                      + (f"yes, at {i['spalling_at']}, {i['spalled_area_mm2']:.0f} mm² ({i['spalled_mass_kg_per_m']:.3f} kg per m of tunnel, "
-                        f"{i['spalled_fragments']} particles in detached fragments)" if i["spalling_at"] else "no"))
+                        f"{i['spalled_fragments']} particles in detached fragments)" if i["spalling_at"] else "no")
+                     + (f"; flaw toe: {i['toe_damaged']} particles D = 1, {i['toe_softened']} softened within 4 mm, failed zone from "
+                        f"the toe reaches the opening at: {i['toe_link_to_opening'] or 'nowhere'}" if "toe_damaged" in i else ""))
         return "\n".join(L)
 
 

@@ -10,17 +10,21 @@ import numpy as np
 
 
 class Lattice:
-    """Lattice indices of particles from their initial positions x0 (N, 2) [m] and spacing dp [m]."""
+    """Lattice indices of particles from their initial positions x0 (N, 2) [m], spacing dp [m] and the
+    lattice's lower-left corner `origin` [m] (default: half a spacing below the lowest particles; give
+    the region's corner when an opening touches the region's edge)."""
 
-    def __init__(self, x0, dp):
+    def __init__(self, x0, dp, origin=None):
         x0 = np.asarray(x0, float)
         if x0.ndim != 2 or x0.shape[1] != 2:
             raise ValueError("x0 must be an (N, 2) array of initial particle positions [m] (2D)")
         if not dp > 0:
             raise ValueError(f"dp = {dp} m must be > 0")
         self.dp = float(dp)
-        self.lo = x0.min(axis=0) - 0.5 * dp                  # lower-left corner of the lattice [m]
+        self.lo = x0.min(axis=0) - 0.5 * dp if origin is None else np.asarray(origin, float)   # lower-left corner [m]
         ij = np.rint((x0 - self.lo) / dp - 0.5).astype(np.int64)
+        if ij.min() < 0:
+            raise ValueError(f"origin = {tuple(self.lo)} m is not below and left of every particle")
         self.i, self.j = ij[:, 0], ij[:, 1]
         self.shape = (int(self.i.max()) + 1, int(self.j.max()) + 1)
         self.slot = -np.ones(self.shape, np.int64)           # particle index at each site, −1 = empty
@@ -93,6 +97,35 @@ def bands(mask, lattice, min_sites=None):
     return sorted(out, key=lambda b: -b["sites"])
 
 
+def _opening_sites(lattice, in_opening):
+    """(hole, surface): lattice sites inside the opening, particle sites with a 4-neighbour in it."""
+    M = lattice.slot >= 0
+    hole = np.zeros(lattice.shape, bool)
+    if (~M).any():
+        hole[~M] = in_opening(lattice.site_centres()[~M])
+    near = np.zeros_like(hole)
+    near[1:, :] |= hole[:-1, :]
+    near[:-1, :] |= hole[1:, :]
+    near[:, 1:] |= hole[:, :-1]
+    near[:, :-1] |= hole[:, 1:]
+    return hole, near & M
+
+
+def opening_surface(lattice, in_opening):
+    """Per particle: True on the surface of the opening (a 4-neighbour lattice site inside it)."""
+    return _opening_sites(lattice, in_opening)[1][lattice.i, lattice.j]
+
+
+def clusters_touching(mask, lattice, seeds):
+    """Per particle: in an 8-connected cluster of `mask` that contains a particle of `seeds` (both per
+    particle, bool) — e.g. the failed zone grown from a flaw tip."""
+    g = lattice.grid(np.asarray(mask, bool), fill=False)
+    lab, _ = _label(g, 8)
+    per = lab[lattice.i, lattice.j]
+    hit = np.unique(per[np.asarray(seeds, bool) & (per > 0)])
+    return np.isin(per, hit) & (per > 0)
+
+
 def spalled(failed, lattice, in_opening, mass=None):
     """Rock spalled off an opening: the failed particles (fully damaged or softened) connected through
     failed particles (8-neighbours) to the opening surface, plus the intact fragments cut off from the
@@ -103,18 +136,7 @@ def spalled(failed, lattice, in_opening, mass=None):
     failed = np.asarray(failed, bool)
     F = lattice.grid(failed, fill=False)
     M = lattice.slot >= 0
-    centres = lattice.site_centres()
-    hole = np.zeros(lattice.shape, bool)
-    empty = ~M
-    if empty.any():
-        hole[empty] = in_opening(centres[empty])
-    # opening surface: particles with a 4-neighbour site in the opening
-    near = np.zeros_like(hole)
-    near[1:, :] |= hole[:-1, :]
-    near[:-1, :] |= hole[1:, :]
-    near[:, 1:] |= hole[:, :-1]
-    near[:, :-1] |= hole[:, 1:]
-    surface = near & M
+    hole, surface = _opening_sites(lattice, in_opening)
     lab, n = _label(F, 8)
     touching = np.unique(lab[surface & F])
     touching = touching[touching > 0]

@@ -146,6 +146,7 @@ TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displaceme
 PLATEN_FRICTION = 0.0              # platen–rock μ_con [-]: the paper's free-slip top
 FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
 TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
+TUNNEL_MAX_SPACING = 1.25 * FLAW_WIDTH   # coarsest grid [m]: the flaw still cuts a full row of particles (ppc = 2)
 
 
 def tunnel_flaw(toe=FLAW_TOE, length=FLAW_LENGTH, width=FLAW_WIDTH, angle=FLAW_ANGLE):
@@ -175,9 +176,9 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m])."""
     if case not in TUNNEL_CASES:
         raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
-    if not (isinstance(spacing, (int, float)) and 0 < spacing <= FLAW_WIDTH * 2.5):
-        raise ValueError(f"spacing = {spacing!r} m must be in (0, {FLAW_WIDTH * 2.5}] m (the flaw, {FLAW_WIDTH * 1e3:g} mm wide, "
-                         "must hold at least two particle rows)")
+    if not (isinstance(spacing, (int, float)) and 0 < spacing <= TUNNEL_MAX_SPACING):
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {TUNNEL_MAX_SPACING}] m (the {FLAW_WIDTH * 1e3:g} mm flaw must "
+                         "cut at least one full particle row, particle spacing l/2)")
     if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
         raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
     from yade import O, utils
@@ -188,7 +189,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     W = TUNNEL_WIDTH
     flaw = tunnel_flaw() if case != "intact" else None
     rock = material or rocks.pan2020_sandstone()
-    holes = [flaw["polygon"]] if case in ("open_flaw", "filled_flaw") else []
+    holes = [flaw["polygon"]] if flaw is not None else []
     s = arch_tunnel_specimen(spacing, rock, ppc, holes=holes)
     if case == "grout_flaw":
         add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
@@ -204,7 +205,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     if case == "filled_flaw":
         hl, hw = _filler_half_sizes(s, flaw, ppc)
         ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
-        from minieigen import Quaternion, Vector3
+        from yade.minieigenHP import Quaternion, Vector3
         filler = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, thick),
                                            orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False))
         O.bodies[filler].state.blockedDOFs = "zXY"  # in the plane: x, y, rotation about z

@@ -1,0 +1,334 @@
+"""Builds doc/validation.md from the output folders of the reference scripts: every case's figures
+(copied to doc/figures/) and numbers, error against run time for the benchmarks, the stability table,
+the uniaxial sweeps, and the tunnel compared with the paper's findings point by point.
+
+    /usr/bin/python3 scripts/report.py                       # reads out/<case>/, writes doc/validation.md
+    /usr/bin/python3 scripts/report.py --root out --doc doc
+
+Folders read (each optional; a missing one is reported with the command that makes it):
+    circular_opening/  scripts/circular_opening.py --convergence
+    penny_crack/       scripts/penny_crack.py
+    stability/         scripts/stability.py
+    uniaxial_flaw/     scripts/uniaxial_flaw.py
+    tunnel/            scripts/tunnel_spalling.py            (default grid, all four cases)
+    tunnel_paper/      scripts/tunnel_spalling.py --paper    (paper grid)
+"""
+import argparse
+import glob
+import json
+import os
+import shutil
+import time
+
+import numpy as np
+
+PARTS = {
+    "circular_opening": "/usr/bin/python3 scripts/circular_opening.py --out out/circular_opening --convergence",
+    "penny_crack": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack",
+    "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
+    "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
+    "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
+    "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --cases intact",
+}
+
+
+class Report:
+    def __init__(self, root, doc):
+        self.root, self.doc = root, doc
+        self.fig_dir = os.path.join(doc, "figures")
+        os.makedirs(self.fig_dir, exist_ok=True)
+        self.lines = []
+
+    def w(self, *lines):
+        self.lines.extend(lines)
+
+    def read(self, part):
+        path = os.path.join(self.root, part, "summary.json")
+        if not os.path.exists(path):
+            return None
+        with open(path) as f:
+            return json.load(f)
+
+    def load(self, part):
+        """summary.json of a part, or None after a line saying how to make it."""
+        s = self.read(part)
+        if s is None:
+            self.w(f"*Not run here* — `{PARTS[part]}` writes `{os.path.join(self.root, part)}/`.", "")
+        return s
+
+    def figure(self, src, name, caption, width=None):
+        """Copy a PNG to doc/figures/ and link it."""
+        if not os.path.exists(src):
+            return False
+        dst = os.path.join(self.fig_dir, name)
+        shutil.copyfile(src, dst)
+        rel = os.path.relpath(dst, self.doc)
+        self.w(f"![{caption}]({rel})" if width is None else f'<img src="{rel}" width="{width}" alt="{caption}">', f"*{caption}*", "")
+        return True
+
+    def figures(self, part, pattern="*.png", skip=()):
+        for p in sorted(glob.glob(os.path.join(self.root, part, pattern))):
+            b = os.path.basename(p)
+            if b in skip:
+                continue
+            self.figure(p, f"{part}_{b}", f"{part}: {b}")
+
+    def write(self):
+        path = os.path.join(self.doc, "validation.md")
+        with open(path, "w") as f:
+            f.write("\n".join(self.lines).rstrip() + "\n")
+        return path
+
+
+def fmt(v, nd=3):
+    if v is None:
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, (int, np.integer)):
+        return f"{v:,}"
+    if isinstance(v, float):
+        return f"{v:.{nd}g}"
+    return str(v)
+
+
+def table(rows, cols):
+    out = ["| " + " | ".join(c for c, _ in cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        out.append("| " + " | ".join(fmt(get(r)) for _, get in cols) + " |")
+    return out + [""]
+
+
+# ------------------------------------------------------------------------------------- benchmarks
+def error_vs_time(R, circ, penny):
+    series = []
+    if circ and circ.get("convergence"):
+        c = circ["convergence"]
+        series.append(("circular opening: max L2 rel. error of σ vs Kirsch", [r["wall_time_s"] for r in c],
+                       [r["l2_rel_error_max"] for r in c], [r["grid_spacing_m"] for r in c]))
+    if penny and penny.get("convergence"):
+        c = penny["convergence"]
+        series.append(("penny crack: L2 rel. error of the opening u_y vs Sneddon", [r["wall_time_s"] for r in c],
+                       [r["uy_l2_rel_error"] for r in c], [r["spacing_m"] for r in c]))
+    R.w("## Error against run time (benchmarks)", "")
+    if not series:
+        R.w("No convergence runs found (`--convergence` of circular_opening.py, the convergence part of penny_crack.py).", "")
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for (label, t, e, l), m in zip(series, ("o-", "s-")):
+        ax.loglog(t, e, m, label=label)
+        for ti, ei, li in zip(t, e, l):
+            ax.annotate(f"l = {li:g} m", (ti, ei), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_xlabel("wall time of the run [s]")
+    ax.set_ylabel("relative error")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    p = os.path.join(R.fig_dir, "error_vs_walltime.png")
+    fig.savefig(p, dpi=120)
+    plt.close(fig)
+    R.w(f"![error against wall time]({os.path.relpath(p, R.doc)})", "")
+    for label, t, e, l in series:
+        R.w(f"**{label}**", "")
+        R.w(*table([dict(l=a, t=b, e=c) for a, b, c in zip(l, t, e)],
+                   [("grid spacing [m]", lambda r: r["l"]), ("wall time [s]", lambda r: r["t"]), ("relative error", lambda r: r["e"])]))
+
+
+def circular(R, s):
+    R.w("## Circular opening (paper Sec. 3.1, Kirsch)", "")
+    if s is None:
+        return
+    R.w(f"Hoop stress at the wall: θ = 0° {fmt(s.get('hoop_stress_theta0_MPa'))} MPa (Kirsch {fmt(s.get('kirsch_hoop_theta0_MPa'))}), "
+        f"θ = 90° {fmt(s.get('hoop_stress_theta90_MPa'))} MPa (Kirsch {fmt(s.get('kirsch_hoop_theta90_MPa'))}); "
+        f"max L2 relative error of the stress profiles {fmt(s.get('l2_rel_error_max'))}; grid {fmt(s.get('grid_spacing_m'))} m, "
+        f"{fmt(s.get('particles'))} particles, wall {fmt(s.get('wall_time_s'))} s.", "")
+    R.figures("circular_opening")
+
+
+def penny(R, s):
+    R.w("## Penny-shaped (line) crack (paper Sec. 3.2, Sneddon)", "")
+    if s is None:
+        return
+    ext = s.get("crack_extension_cells") or []
+    paper = {round(p["t_s"], 3): p["cells"] for p in s.get("paper_crack_extension_cells", [])}
+    if ext:
+        R.w("Crack extension (cells) against the paper's Fig. 9:", "")
+        R.w(*table(ext, [("t [s]", lambda r: r["t_s"]), ("left", lambda r: r.get("left")), ("right", lambda r: r.get("right")),
+                         ("paper", lambda r: paper.get(round(r["t_s"], 3)))]))
+    R.w(f"Wall time {fmt(s.get('wall_time_s'))} s, {fmt(s.get('particles'))} particles.", "")
+    R.figures("penny_crack")
+
+
+def stability(R, s):
+    R.w("## Stability suite", "")
+    if s is None:
+        return
+    R.w(*table(s.get("cases", []), [("case", lambda r: r.get("case")), ("outcome", lambda r: r.get("outcome")),
+                                    ("max energy ratio", lambda r: r.get("max_energy_ratio")), ("steps", lambda r: r.get("steps")),
+                                    ("NaN seen", lambda r: r.get("nan_seen")), ("wall [s]", lambda r: r.get("wall_time_s")),
+                                    ("passed", lambda r: r.get("passed"))]))
+    R.w(f"All passed: {fmt(s.get('all_passed'))}.", "")
+    R.figures("stability")
+
+
+def uniaxial(R, s):
+    R.w("## Uniaxial compression with a flaw (paper Sec. 3.3)", "")
+    if s is None:
+        return
+    flat = {k: v for k, v in s.items() if isinstance(v, (int, float, str, bool))}
+    if flat:
+        R.w(*table([{"k": k, "v": v} for k, v in flat.items()], [("quantity", lambda r: r["k"]), ("value", lambda r: r["v"])]))
+    for k, v in s.items():
+        if isinstance(v, list) and v and isinstance(v[0], dict):
+            keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None][:8]
+            R.w(f"**{k}**", "")
+            R.w(*table(v, [(c, (lambda c: lambda r: r.get(c))(c)) for c in keys]))
+    R.figures("uniaxial_flaw")
+
+
+# ------------------------------------------------------------------------------------------ tunnel
+def tunnel(R, s, part, title):
+    R.w(f"## {title}", "")
+    if s is None:
+        return None
+    cs = s["cases"]
+
+    def at(e, d):
+        for p in e["axial_stress_MPa_at"]:
+            if abs(p["displacement_mm"] - d) < 1e-9:
+                return p["stress_MPa"]
+        return None
+    R.w(*table(cs, [("case", lambda e: e["case"]), ("grid [mm]", lambda e: e["grid_spacing_m"] * 1e3),
+                    ("particles", lambda e: e["particles"]), ("steps", lambda e: e["steps"]),
+                    ("wall [s]", lambda e: e["wall_time_s"]),
+                    ("M particle-steps/s", lambda e: (e["particle_steps_per_s"] or 0) / 1e6),
+                    ("final displ. [mm]", lambda e: e["final_displacement_mm"]),
+                    ("σ at 0.5 mm [MPa]", lambda e: at(e, 0.5)), ("σ at 1.0 mm", lambda e: at(e, 1.0)),
+                    ("σ at 2.0 mm", lambda e: at(e, 2.0)), ("symmetry D (8 ms)", lambda e: e["symmetry_damage"]),
+                    ("first damage", lambda e: e["first_damage_location"])]))
+    d = os.path.join(R.root, part)
+    R.figure(os.path.join(d, "axial_stress.png"), f"{part}_axial_stress.png", "Axial stress against platen displacement (cf. paper Fig. 17)")
+    txt = os.path.join(d, "summary.txt")
+    if os.path.exists(txt):
+        R.w("Text summary written by the run:", "", "```", open(txt).read().rstrip(), "```", "")
+    info = {}
+    for e in cs:
+        cj = os.path.join(d, e["case"], "case.json")
+        info[e["case"]] = json.load(open(cj)) if os.path.exists(cj) else None
+        for key in ("08ms", "12ms", "20ms"):
+            R.figure(os.path.join(d, e["case"], f"fields_{key}.png"), f"{part}_{e['case']}_fields_{key}.png",
+                     f"{e['case']}, t = {int(key[:2])} ms: accumulated plastic strain, damage (spalled region outlined), "
+                     "max tensile principal stress, x and y displacement")
+    return cs, info
+
+
+def compare_with_paper(R, cs, info):
+    """The paper's findings for the tunnel (Sec. 4, Figs. 17–19), each checked against our numbers."""
+    R.w("## The tunnel against the paper's findings, point by point", "")
+    by = {e["case"]: e for e in cs}
+    rows = []
+
+    def snap(case, key):
+        i = info.get(case)
+        return (i or {}).get("snapshots", {}).get(key)
+
+    def stress_at(case, dmm):
+        for p in by[case]["axial_stress_MPa_at"]:
+            if abs(p["displacement_mm"] - dmm) < 1e-9:
+                return p["stress_MPa"]
+        return None
+    # 1. Fig. 17 ordering
+    if all(c in by for c in ("intact", "open_flaw", "filled_flaw")):
+        ds = [p["displacement_mm"] for p in by["intact"]["axial_stress_MPa_at"] if p["displacement_mm"] > 0]
+        ok = [d for d in ds if None not in (stress_at("open_flaw", d), stress_at("filled_flaw", d))
+              and stress_at("open_flaw", d) < stress_at("intact", d) < stress_at("filled_flaw", d)]
+        n = len([d for d in ds if None not in (stress_at("open_flaw", d), stress_at("filled_flaw", d))])
+        vals = "; ".join(f"{d:g} mm: open {stress_at('open_flaw', d):.1f} / intact {stress_at('intact', d):.1f} / filled "
+                         f"{stress_at('filled_flaw', d):.1f}" + (f" / grout {stress_at('grout_flaw', d):.1f}" if "grout_flaw" in by and stress_at('grout_flaw', d) is not None else "")
+                         + " MPa" for d in (0.5, 1.0, 2.0) if d in ds and stress_at("open_flaw", d) is not None and stress_at("filled_flaw", d) is not None)
+        verdict = "agrees" if n and len(ok) == n else ("partly" if ok else "differs")
+        rows.append(("Fig. 17: at equal displacement open flaw < intact < rigid-filled flaw; no peak", f"holds at {len(ok)} of {n} displacements (0.1 mm apart); {vals}", verdict))
+    else:
+        rows.append(("Fig. 17 ordering", "needs the intact, open_flaw and filled_flaw runs", "not run"))
+    if "grout_flaw" in by and "open_flaw" in by:
+        g = [(p["displacement_mm"], p["stress_MPa"]) for p in by["grout_flaw"]["axial_stress_MPa_at"] if p["displacement_mm"] > 0]
+        above_open = sum(1 for dmm, v in g if stress_at("open_flaw", dmm) is not None and v > stress_at("open_flaw", dmm))
+        rows.append(("Beyond the paper: grout-filled flaw (Pan's experiments: filling alleviates the flaw's effect)",
+                     f"grout above the open flaw at {above_open} of {len(g)} displacements", "see text"))
+    # 2. first tensile cracks at the floor, symmetric
+    if "intact" in by:
+        e = by["intact"]
+        loc, sym = e["first_damage_location"], e["symmetry_damage"]
+        good = loc is not None and "floor" in loc and sym is not None and sym >= 0.8
+        rows.append(("Fig. 18d: symmetric tensile cracks at the tunnel floor first", f"first D = 1 at: {loc}; damage symmetry at 8 ms {fmt(sym)}",
+                     "agrees" if good else ("partly" if (loc and "floor" in loc) or (sym or 0) >= 0.8 else "differs")))
+        s8 = snap("intact", "08ms")
+        if s8:
+            sides = {b["side"] for b in s8["bands"]}
+            rows.append(("Fig. 18a: at 8 ms the plastic zones are symmetric, two triangles beside the tunnel",
+                         f"plastic-strain symmetry {fmt(s8['symmetry_plastic'])}; softened {100 * s8['softened_fraction']:.1f} % of the rock; "
+                         f"softened clusters on: {', '.join(sorted(sides)) or 'none'} (shape: see the 8 ms figure)",
+                         "agrees" if (s8["symmetry_plastic"] or 0) >= 0.8 else "differs"))
+        s12 = snap("intact", "12ms")
+        if s12:
+            angs = [abs(b["angle_deg"]) for b in s12["bands"][:4]]
+            close = [a for a in angs if abs(a - 55) <= 10]
+            rows.append(("Fig. 18b: shear bands inclined about 55° localise at 12 ms", "band inclinations to the horizontal: "
+                         + (", ".join(f"{b['side']} {abs(b['angle_deg']):.0f}°" for b in s12["bands"][:4]) or "no band"),
+                         "agrees" if close else ("differs" if angs else "no band")))
+        s20 = snap("intact", "20ms")
+        if s20:
+            at = s20.get("spalling_at")
+            rows.append(("Fig. 18e–g: spalling starts at the opening surface, at the tunnel waist",
+                         f"spalled region {s20['spalled_area_mm2']:.0f} mm², {fmt(s20['spalled_mass_kg_per_m'])} kg/m, at: {at or 'none'}",
+                         "agrees" if at and "wall" in at else ("partly" if at else "differs")))
+    for case, claim, want in (("open_flaw", "Fig. 19a: open flaw → stress concentration and an anti-wing shear crack at the flaw toe", "toe"),
+                              ("filled_flaw", "Fig. 19e, f: rigid-filled flaw → a mixed shear-tensile crack from the flaw toe to the tunnel corner", "link")):
+        s20 = snap(case, "20ms")
+        if not s20:
+            rows.append((claim, f"needs the {case} run", "not run"))
+            continue
+        if want == "toe":
+            ok = s20.get("toe_softened", 0) > 0
+            rows.append((claim, f"within 4 mm of the toe: {s20.get('toe_softened')} softened, {s20.get('toe_damaged')} fully damaged particles; "
+                         f"damage symmetry {fmt(s20['symmetry_damage'])} (intact {fmt((snap('intact', '20ms') or {}).get('symmetry_damage'))})",
+                         "agrees" if ok else "differs"))
+        else:
+            link = s20.get("toe_link_to_opening")
+            rows.append((claim, f"failed zone from the toe reaches the opening at: {link or 'nowhere'}",
+                         "agrees" if link and ("corner" in link or "wall" in link or "spandrel" in link) else "differs"))
+    R.w("| paper (Sec. 4) | this code | verdict |", "|---|---|---|")
+    for a, b, c in rows:
+        R.w(f"| {a} | {b} | **{c}** |")
+    R.w("")
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--root", default="out", help="folder holding the output folders (default out)")
+    ap.add_argument("--doc", default="doc", help="doc folder (default doc): writes validation.md and figures/")
+    a = ap.parse_args()
+    R = Report(a.root, a.doc)
+    R.w("# Validation report", "",
+        f"Generated by `scripts/report.py` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} from the output folders under "
+        f"`{a.root}/`. Regenerate: run the commands named in each section, then `/usr/bin/python3 scripts/report.py`.", "")
+    tparts = [tunnel(R, R.load(part), part, title) for part, title in
+              (("tunnel", "Arch tunnel spalling (paper Sec. 4), default grid"), ("tunnel_paper", "Arch tunnel at the paper's grid (l = 1 mm)"))]
+    tun = tparts[0] or tparts[1]
+    if tun:
+        compare_with_paper(R, *tun)
+    circ, pen = R.read("circular_opening"), R.read("penny_crack")
+    error_vs_time(R, circ, pen)
+    circular(R, R.load("circular_opening"))
+    penny(R, R.load("penny_crack"))
+    stability(R, R.load("stability"))
+    uniaxial(R, R.load("uniaxial_flaw"))
+    print(f"wrote {R.write()}")
+
+
+if __name__ == "__main__":
+    main()

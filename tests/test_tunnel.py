@@ -1,0 +1,83 @@
+"""The arch-tunnel scene of paper Sec. 4 (yade_mpm.cases.arch_tunnel) on a coarse grid: the flaw cut,
+the rigid filler fitting it without touching a particle, the grout filling it; the platen's first
+stress is the 1D impact stress ρ c_p v (plane strain, slip walls) until the wave returns from the
+opening; the intact scene stays mirror symmetric; a filled-flaw run resumes bitwise from a checkpoint."""
+import math
+
+import numpy as np
+import pytest
+import yade_mpm as ym
+from yade_mpm import analysis, cases, checkpoint, rocks
+
+yade = pytest.importorskip("yade")
+L = 0.0025                        # coarsest grid the 2 mm flaw allows (two particle rows)
+
+
+def test_flaw_cut_filler_and_grout():
+    s_int, _ = cases.arch_tunnel("intact", L)
+    n_int = s_int.numParticles
+    s, b = cases.arch_tunnel("filled_flaw", L)
+    f, dp = b["flaw"], L / 2
+    assert (n_int - s.numParticles) * dp ** 2 == pytest.approx(f["length"] * f["width"], rel=0.2)
+    assert np.allclose(f["toe"], (0.045, 0.08)) and f["angle"] == pytest.approx(math.radians(60))
+    # the filler: inside the flaw, and no particle's cell (half-edge d0 = dp/2 around it) overlaps it
+    from yade import O
+    box = O.bodies[b["filler"]]
+    hl, hw = box.shape.extents[0], box.shape.extents[1]
+    assert 0.9 * f["length"] / 2 < hl <= f["length"] / 2 and 0 < hw <= f["width"] / 2
+    r = ym.get(s, "pos") - f["center"]
+    along, across = np.abs(r @ f["direction"]), np.abs(r @ f["normal"])
+    gap = np.hypot(np.maximum(along - hl, 0), np.maximum(across - hw, 0))
+    assert gap.min() >= dp / 2 - 1e-12
+    assert b["filler"] in b["rigid"].ids and b["platen"] in b["rigid"].ids
+    s_g, b_g = cases.arch_tunnel("grout_flaw", L)
+    assert s_g.numParticles == n_int                 # the grout fills the cut exactly
+    with pytest.raises(ValueError, match="case"):
+        cases.arch_tunnel("half_flaw", L)
+    with pytest.raises(ValueError, match="spacing"):
+        cases.arch_tunnel("intact", 0.004)
+
+
+def test_platen_impact_stress_and_symmetry():
+    from yade import O
+    s, b = cases.arch_tunnel("intact", L)
+    rb, pid, W = b["rigid"], b["platen"], b["width"]
+    m = rocks.pan2020_sandstone()
+    rho_c_v = m.density * m.pWaveSpeed() * cases.PLATEN_SPEED     # 1D (confined) impact stress [Pa]
+    sig = []
+    while s.time < 31e-6:          # the wave reaches the crown (50 mm) at 17.6 µs and is back at 35 µs
+        O.step()
+        if s.time > 11e-6:
+            sig.append(rb.force(pid)[1] / W)
+    assert np.mean(sig) == pytest.approx(rho_c_v, rel=0.01)
+    assert np.max(np.abs(np.array(sig) / rho_c_v - 1)) < 0.02
+    lat = analysis.Lattice(ym.get(s, "pos"), L / 2, origin=(0, 0))
+    assert analysis.mirror_symmetry(ym.get(s, "stress")[:, 1], lat, W / 2) > 0.999999
+    assert analysis.mirror_symmetry(ym.get(s, "vel")[:, 0], lat, W / 2) < -0.999999   # v_x antisymmetric
+
+
+def test_filled_flaw_resumes_bitwise(tmp_path):
+    from yade import O
+
+    def state(s, b):
+        bs = [O.bodies[i].state for i in (b["platen"], b["filler"])]
+        return ({k: np.array(v) for k, v in ym.views(s).items()},
+                [(tuple(x.pos), tuple(x.vel), tuple(x.ori), tuple(x.angVel)) for x in bs], (O.iter, O.time, s.time))
+
+    N = 40
+    s, b = cases.arch_tunnel("filled_flaw", L)
+    O.run(N, True)
+    ref = state(s, b)
+    s, b = cases.arch_tunnel("filled_flaw", L)
+    O.run(N // 2 + 3, True)
+    checkpoint.save(tmp_path / "t.ckpt", meta={"case": "filled_flaw"})
+    s, b = cases.arch_tunnel("filled_flaw", L)
+    checkpoint.load(tmp_path / "t.ckpt", meta={"case": "filled_flaw"})
+    O.run(N - N // 2 - 3, True)
+    got = state(s, b)
+    for k in ref[0]:
+        np.testing.assert_array_equal(ref[0][k], got[0][k], err_msg=k)
+    assert ref[1] == got[1] and ref[2] == got[2]
+    s, b = cases.arch_tunnel("open_flaw", L)
+    with pytest.raises(checkpoint.CheckpointError, match="another scene"):
+        checkpoint.load(tmp_path / "t.ckpt")
