@@ -10,6 +10,7 @@ import yade_mpm as ym
 from yade_mpm import analysis, cases, checkpoint, rocks
 
 yade = pytest.importorskip("yade")
+pytest.importorskip("yade_mpm.bodies")   # rigid-body contact (platen, filler)
 L = 0.0025                        # coarsest grid the 2 mm flaw allows (two particle rows)
 
 

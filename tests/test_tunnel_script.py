@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("yade")
+pytest.importorskip("yade_mpm.bodies")   # rigid-body contact (platen, filler)
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KEYS = {"case", "grid_spacing_m", "particles", "steps", "wall_time_s", "particle_steps_per_s", "final_displacement_mm",
         "axial_stress_MPa_at", "symmetry_damage", "first_damage_location"}
