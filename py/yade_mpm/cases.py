@@ -8,7 +8,8 @@ scenes here and keep only their command line and analysis.
     arch_tunnel_specimen(spacing, ...)  the tunnel specimen with its opening and slip walls (no top load)
     arch_tunnel(case, spacing, ...)  paper Sec. 4 + grout: the full scene with the YADE platen (and filler)
 
-Quantities are SI; stresses are tension positive inside the solver.
+Rock parameters come from ``yade_mpm.rocks``; the small scenes of the stability suite live with their
+checks in ``yade_mpm.stability``. Quantities are SI; stresses are tension positive inside the solver.
 """
 import math
 

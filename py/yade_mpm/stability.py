@@ -24,9 +24,9 @@ import time
 import numpy as np
 
 from . import rocks, runner
-from ._core import MpmSimulationError, Solver2D
+from ._core import MpmSimulationError
 from .materials import DpGkMat, ElasticMat
-from .scene import SYM_NAMES, add_region, apply_traction, boundary_particles, get, make_solver
+from .scene import SYM_NAMES, add_region, apply_traction, boundary_particles, dim_of, get, make_solver
 
 # Allowed excess of KE + U_el over the input energy. Explicit (symplectic-Euler-like) integration does
 # not conserve the discrete energy exactly; its oscillation is O(C) of the energy in the highest modes,
@@ -229,7 +229,7 @@ CASES = {
 
 # ----------------------------------------------------------------------------------------------- checks
 def state_fields(s):
-    d = 2 if isinstance(s, Solver2D) else 3
+    d = dim_of(s)
     return ([f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
             + ["vol", "damage", "epsP"])
 
