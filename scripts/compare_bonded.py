@@ -1,0 +1,326 @@
+"""yade-mpm side by side with YADE's bonded-particle rock model JCFpm (Scholtès & Donzé 2012).
+
+1. Uniaxial compression of the paper's Sec. 3.3 specimen (50 × 150 mm, Miao et al. 2018 sandstone),
+   intact and with the 25 × 2 mm open flaw at 30°, between frictionless platens moving together at
+   --platen-speed:
+   - MPM: 2D plane strain WLS-MPM with DP–GK damage (yade_mpm.cases uniaxial builder, rigid platens
+     through PTS contact), grid spacing --mpm-spacing.
+   - JCFpm: a layer of bonded spheres, centres at z = 0, motion restricted to the plane
+     (yade_mpm.bonded; plane strain: ε_zz = 0 exactly), mean radius --dem-radius, thickness mapping
+     t = 2 r̄ (stress = platen force / (W t)).
+   "E" on both sides is the apparent plane-strain modulus Δσ_yy/Δε_yy of the test (slope between 10 %
+   and 50 % of the peak, platen displacement / specimen height); for the elastic MPM rock it is
+   E/(1 − ν²). JCFpm micro-parameters are calibrated on the intact specimen to the MPM's E and peak
+   stress (fixed-point scaling: young ← young·E_mpm/E, tensile and cohesion ← ·σ_mpm/σ, ks/kn = 0.3,
+   cohesion/tensile = 4, contact friction φ = 38°, until both are within --calib-tol), then used
+   unchanged on the flawed specimen.
+2. Circular opening (paper Sec. 3.1 loads) against Kirsch: stress error vs wall time for both methods
+   on one plot. MPM: scripts/circular_opening.py (its convergence table) on an --kirsch-domain block;
+   JCFpm: unbreakable bonds, far-field forces on the edge spheres, Love–Weber stress in windows of
+   radius a/2 along the two lines (Kirsch averaged over the same windows), several sphere sizes.
+
+Outputs in --out: summary.json, calibration.csv, curves_*.csv, stress_strain.png, cracks_intact.png,
+cracks_open_flaw.png, kirsch_error_vs_time.png, kirsch_*.csv.
+
+    PYTHONPATH=py OMP_NUM_THREADS=1 /usr/bin/python3 scripts/compare_bonded.py --out out/compare_bonded
+    ... --parts kirsch          # one part only (uniaxial, kirsch)
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+import yade_mpm as ym
+from yade_mpm import bonded, cases, rocks
+from yade_mpm import output as out
+
+MPa, GPa = 1e6, 1e9
+SAND = rocks.MIAO2018_SANDSTONE
+# JCFpm choices kept fixed during the calibration (documented in doc/mpm_vs_bonded.md)
+KS_KN = 0.3              # ks/kn (JCFpmMat.poisson)
+COH_OVER_TENS = 4.0      # bond cohesion / tensile strength
+FRICTION_DEG = math.degrees(SAND["frictionAngle"])
+# initial guess from one pilot run (r̄ = 0.75 mm, 0.5 m/s, ks/kn = 0.3, idf = 1.3): E_app ≈ 0.51·young,
+# peak ≈ 3.9·tensile; the calibration only needs it to be within a factor of a few
+PILOT_E_RATIO, PILOT_PEAK_RATIO = 0.51, 3.9
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--parts", default="uniaxial,kirsch", help="comma list of: uniaxial, kirsch")
+    p.add_argument("--platen-speed", type=float, default=0.5, help="platen closing speed [m/s] (both methods)")
+    p.add_argument("--mpm-spacing", type=float, default=1e-3, help="MPM grid spacing [m] (flaw width 2 mm ≥ 2 cells)")
+    p.add_argument("--dem-radius", type=float, default=0.75e-3, help="JCFpm mean sphere radius [m]")
+    p.add_argument("--calib-tol", type=float, default=0.05, help="calibration stops when E and peak are within this")
+    p.add_argument("--calib-iters", type=int, default=4, help="maximum calibration runs")
+    p.add_argument("--max-strain", type=float, default=0.012, help="axial strain limit of a uniaxial run")
+    p.add_argument("--kirsch-domain", type=float, default=1.2, help="side of the square block of the Kirsch test [m]")
+    p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (table: 2l, 1.5l, l)")
+    p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
+                   help="JCFpm mean radii [m] of the Kirsch runs")
+    p.add_argument("--cache", default=None, help="directory for cached disc packings (default: OUT/packings)")
+    a = p.parse_args(argv)
+    parts = set(a.parts.split(","))
+    if not parts <= {"uniaxial", "kirsch"}:
+        raise ValueError(f"--parts = {a.parts}: allowed uniaxial, kirsch")
+    for n in ("platen_speed", "mpm_spacing", "dem_radius", "calib_tol", "max_strain", "kirsch_domain", "kirsch_mpm_spacing"):
+        v = getattr(a, n)
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"--{n.replace('_', '-')} = {v} must be > 0")
+    if not a.dem_radius < 0.005:
+        raise ValueError(f"--dem-radius = {a.dem_radius} m must be < 5 mm (≥ 5 spheres across the 50 mm specimen)")
+    if a.calib_iters < 1:
+        raise ValueError(f"--calib-iters = {a.calib_iters} must be ≥ 1")
+    if any(not (0 < r <= 0.05) for r in a.kirsch_dem_radii):
+        raise ValueError(f"--kirsch-dem-radii = {a.kirsch_dem_radii} m: each must be in (0, 0.05] m")
+    a.parts = parts
+    a.cache = a.cache or os.path.join(a.out, "packings")
+    return a
+
+
+def log(msg):
+    print(f"[compare_bonded] {msg}", flush=True)
+
+
+# ---------------------------------------------------------------------------------------------- MPM
+def mpm_uniaxial(flaw, a):
+    """MPM uniaxial run (cases uniaxial builder): dict(strain, stress [Pa] compression +, particles,
+    wall_time_s, pos, damage, plastic_strain)."""
+    raise NotImplementedError("waiting for the uniaxial builder of helper 'contact'")
+
+
+# ------------------------------------------------------------------------------------------- JCFpm
+def packing(a, lo, hi, r):
+    """Disc packing (cached) and the wall time it took to make it (0 when cached before)."""
+    t0 = time.time()
+    P = bonded.disc_packing(lo, hi, r, cache_dir=a.cache)
+    return P, time.time() - t0
+
+
+def jcfpm_uniaxial(P, micro, holes, a, label):
+    prog = ym.Progress(a.max_strain, label, 20.0)
+    res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.max_strain,
+                          crack_dir=os.path.join(a.out, "jcfpm_cracks"), label=label,
+                          progress=lambda e, s: prog.update(0, e))
+    res["youngs_modulus"] = bonded.apparent_modulus(res["strain"], res["stress"])
+    res["peak_stress"] = float(np.max(res["stress"]))
+    return res
+
+
+def calibrate(P, target_E, target_peak, a):
+    """Fixed-point scaling of (young) and (tensile, cohesion) until E and peak are within calib_tol."""
+    micro = bonded.JcfpmMicro(young=target_E / PILOT_E_RATIO, ks_kn=KS_KN, tensile=target_peak / PILOT_PEAK_RATIO,
+                              cohesion=COH_OVER_TENS * target_peak / PILOT_PEAK_RATIO, friction_deg=FRICTION_DEG)
+    rows, res = [], None
+    t0 = time.time()
+    for it in range(a.calib_iters):
+        res = jcfpm_uniaxial(P, micro, (), a, f"calib{it}")
+        eE, eP = res["youngs_modulus"] / target_E - 1, res["peak_stress"] / target_peak - 1
+        rows.append(dict(iteration=it, **micro.as_dict(), youngs_modulus_GPa=res["youngs_modulus"] / GPa,
+                         peak_stress_MPa=res["peak_stress"] / MPa, rel_error_E=eE, rel_error_peak=eP,
+                         wall_time_s=res["wall_time_s"]))
+        log(f"calibration {it}: young = {micro.young / GPa:.3f} GPa, tensile = {micro.tensile / MPa:.3f} MPa → "
+            f"E = {res['youngs_modulus'] / GPa:.3f} GPa ({100 * eE:+.1f} %), peak = {res['peak_stress'] / MPa:.2f} MPa "
+            f"({100 * eP:+.1f} %), {res['wall_time_s']:.0f} s")
+        if abs(eE) <= a.calib_tol and abs(eP) <= a.calib_tol:
+            break
+        s = target_peak / res["peak_stress"]
+        micro = bonded.JcfpmMicro(young=micro.young * target_E / res["youngs_modulus"], ks_kn=micro.ks_kn,
+                                  tensile=micro.tensile * s, cohesion=micro.cohesion * s, friction_deg=micro.friction_deg)
+    return micro, res, rows, time.time() - t0
+
+
+# ------------------------------------------------------------------------------------------ figures
+def write_curve(path, strain, stress):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["axial_strain", "axial_stress_MPa"])
+        w.writerows(zip(np.round(strain, 8), np.round(np.asarray(stress) / MPa, 5)))
+
+
+def plot_curves(path, results):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
+    for ax, (case, r) in zip(axes[0], results.items()):
+        for meth, style in (("mpm", "k-"), ("jcfpm", "r-")):
+            if meth in r:
+                q = r[meth]
+                ax.plot(100 * np.asarray(q["strain"]), np.asarray(q["stress"]) / MPa, style,
+                        label=f"{'MPM (DP–GK)' if meth == 'mpm' else 'JCFpm'}: E = {q['youngs_modulus'] / GPa:.2f} GPa, "
+                              f"peak {q['peak_stress'] / MPa:.1f} MPa")
+        ax.set_xlabel("axial strain [%]")
+        ax.set_ylabel("axial stress [MPa]")
+        ax.set_title(case.replace("_", " "))
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def plot_cracks(path, mpm, dem, holes, title):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle as CircleP, Polygon as PolyP
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(7, 8.5))
+    if mpm is not None:
+        sc = a1.scatter(mpm["pos"][:, 0] * 1e3, mpm["pos"][:, 1] * 1e3, c=mpm["damage"], s=1.0, cmap="inferno_r",
+                        vmin=0, vmax=1, marker="s", linewidths=0)
+        fig.colorbar(sc, ax=a1, shrink=0.6, label="damage D")
+    a1.set_title(f"MPM: damage D ({mpm['particles'] if mpm else 0} particles)", fontsize=9)
+    P = dem["discs"]
+    a2.add_collection(PatchCollection([CircleP((x * 1e3, y * 1e3), r * 1e3) for x, y, r in P], facecolor="0.85",
+                                      edgecolor="0.6", linewidths=0.2))
+    c = dem["cracks"]
+    for typ, col, name in ((0, "tab:red", "tensile"), (1, "tab:blue", "shear")):
+        m = c[:, 2] == typ
+        a2.plot(c[m, 0] * 1e3, c[m, 1] * 1e3, ".", ms=2.0, color=col, label=f"{name} ({int(m.sum())})")
+    a2.legend(fontsize=8, loc="upper right")
+    a2.set_title(f"JCFpm: broken bonds ({len(P)} spheres)", fontsize=9)
+    for ax in (a1, a2):
+        for h in holes:
+            ax.add_patch(PolyP(h.v * 1e3, closed=True, fill=False, ec="g", lw=0.8))
+        ax.set_aspect("equal")
+        ax.set_xlim(-2, 52)
+        ax.set_ylim(-2, 152)
+        ax.set_xlabel("x [mm]")
+    a1.set_ylabel("y [mm]")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=140)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------------------------------- parts
+def uniaxial_part(a, summary):
+    lo, hi = (0.0, 0.0), (cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT)
+    P, t_pack = packing(a, lo, hi, a.dem_radius)
+    log(f"disc packing: {len(P)} spheres, r̄ = {a.dem_radius * 1e3} mm ({t_pack:.1f} s)")
+    results = {}
+    mpm_int = mpm_uniaxial(False, a)
+    mpm_int["youngs_modulus"] = bonded.apparent_modulus(mpm_int["strain"], mpm_int["stress"])
+    mpm_int["peak_stress"] = float(np.max(mpm_int["stress"]))
+    log(f"MPM intact: E = {mpm_int['youngs_modulus'] / GPa:.3f} GPa, peak = {mpm_int['peak_stress'] / MPa:.2f} MPa, "
+        f"{mpm_int['wall_time_s']:.0f} s")
+    micro, dem_int, rows, t_cal = calibrate(P, mpm_int["youngs_modulus"], mpm_int["peak_stress"], a)
+    with open(os.path.join(a.out, "calibration.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    results["intact"] = dict(mpm=mpm_int, jcfpm=dem_int)
+    holes = [cases.uniaxial_flaw()]
+    mpm_fl = mpm_uniaxial(True, a)
+    mpm_fl["youngs_modulus"] = bonded.apparent_modulus(mpm_fl["strain"], mpm_fl["stress"])
+    mpm_fl["peak_stress"] = float(np.max(mpm_fl["stress"]))
+    dem_fl = jcfpm_uniaxial(P, micro, holes, a, "open_flaw")
+    results["open_flaw"] = dict(mpm=mpm_fl, jcfpm=dem_fl)
+    for case, r in results.items():
+        for meth, q in r.items():
+            write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
+            summary.setdefault(case, {})[meth] = dict(youngs_modulus_GPa=q["youngs_modulus"] / GPa,
+                                                      peak_stress_MPa=q["peak_stress"] / MPa,
+                                                      particles=int(q["particles"]), wall_time_s=q["wall_time_s"])
+        keep = np.ones(len(P), bool)
+        for h in (holes if case == "open_flaw" else ()):
+            keep &= ~bonded.overlapping(h, P[:, :2], P[:, 2])
+        r["jcfpm"]["discs"] = P[keep]
+        plot_cracks(os.path.join(a.out, f"cracks_{case}.png"), r["mpm"], r["jcfpm"], holes if case == "open_flaw" else [],
+                    f"{case.replace('_', ' ')}: end of the run (MPM ε = {100 * r['mpm']['strain'][-1]:.2f} %, "
+                    f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
+        for meth in ("jcfpm",):
+            q = r[meth]
+            summary[case][meth].update(tensile_cracks=q["tensile_cracks"], shear_cracks=q["shear_cracks"],
+                                       bonds=q["bonds"], steps=q["steps"])
+    plot_curves(os.path.join(a.out, "stress_strain.png"), results)
+    summary["calibration"] = dict(procedure="fixed-point scaling: young *= E_mpm/E, tensile and cohesion *= peak_mpm/peak; "
+                                            f"ks/kn = {KS_KN}, cohesion/tensile = {COH_OVER_TENS}, friction = {FRICTION_DEG:.1f} deg",
+                                  runs=rows, wall_time_s=t_cal, micro=micro.as_dict(), packing_wall_time_s=t_pack,
+                                  packing_spheres=int(len(P)), mean_radius_m=a.dem_radius,
+                                  layer_thickness_m=bonded.layer_thickness(P), platen_speed_m_s=a.platen_speed,
+                                  mpm_spacing_m=a.mpm_spacing)
+
+
+def kirsch_part(a, summary):
+    rows = []
+    # MPM: the circular-opening script's own convergence table (error and wall time per spacing)
+    mdir = os.path.join(a.out, "kirsch_mpm")
+    l = a.kirsch_mpm_spacing
+    cmd = [sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "circular_opening.py"), "--out", mdir,
+           "--domain", str(a.kirsch_domain), "--spacing", str(l), "--no-vtu", "--threads", "1",
+           "--convergence-spacings", str(2 * l), str(1.5 * l), str(l)]
+    log("MPM circular opening: " + " ".join(cmd[1:]))
+    subprocess.run(cmd, check=True)
+    with open(os.path.join(mdir, "summary.json")) as f:
+        ms = json.load(f)
+    for r in ms["convergence"]:
+        rows.append(dict(method="mpm", resolution_m=r["grid_spacing_m"], particles=r["particles"],
+                         wall_time_s=r["wall_time_s"], l2_rel_error_max=r["l2_rel_error_max"]))
+    # JCFpm
+    c, L = cases.OPENING_CENTER, a.kirsch_domain
+    micro = bonded.JcfpmMicro(young=rocks.GRANITE["young"], ks_kn=KS_KN, tensile=1e15, cohesion=1e15, friction_deg=30.0)
+    profiles = {}
+    for r in sorted(a.kirsch_dem_radii, reverse=True):
+        P, t_pack = packing(a, (c - L / 2, c - L / 2), (c + L / 2, c + L / 2), r)
+        res = bonded.circular_opening(P, micro, (c, c), cases.OPENING_RADIUS, cases.OPENING_SXX, cases.OPENING_SYY,
+                                      rocks.GRANITE["density"])
+        log(f"JCFpm circular opening r̄ = {r} m: {res['particles']} spheres, {res['steps']} steps, "
+            f"{res['wall_time_s']:.1f} s, max L2 error {100 * res['l2_rel_error_max']:.1f} %")
+        rows.append(dict(method="jcfpm", resolution_m=r, particles=res["particles"], wall_time_s=res["wall_time_s"],
+                         l2_rel_error_max=res["l2_rel_error_max"], packing_wall_time_s=t_pack))
+        profiles[r] = res["profiles"]
+    with open(os.path.join(a.out, "kirsch_error_vs_time.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=["method", "resolution_m", "particles", "wall_time_s", "l2_rel_error_max",
+                                          "packing_wall_time_s"])
+        w.writeheader()
+        w.writerows(rows)
+    summary["kirsch"] = [dict(method=r["method"], wall_time_s=r["wall_time_s"], l2_rel_error_max=r["l2_rel_error_max"],
+                              particles=r["particles"], resolution_m=r["resolution_m"]) for r in rows]
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4.3))
+    for meth, st, name in (("mpm", "ko-", "MPM (grid spacing l)"), ("jcfpm", "rs-", "JCFpm (mean radius r̄)")):
+        q = [r for r in rows if r["method"] == meth]
+        ax.loglog([r["wall_time_s"] for r in q], [100 * r["l2_rel_error_max"] for r in q], st, label=name)
+        for r in q:
+            ax.annotate(f"{r['resolution_m'] * 1e3:g} mm, {r['particles']}", (r["wall_time_s"], 100 * r["l2_rel_error_max"]),
+                        fontsize=7, textcoords="offset points", xytext=(4, 3))
+    ax.set_xlabel("wall time [s] (one thread)")
+    ax.set_ylabel("max relative L2 stress error vs Kirsch [%]")
+    ax.set_title(f"circular opening, {L} m block, a = {cases.OPENING_RADIUS} m", fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    fig.savefig(os.path.join(a.out, "kirsch_error_vs_time.png"), dpi=130)
+    plt.close(fig)
+
+
+def main(argv=None):
+    a = parse_args(argv)
+    os.makedirs(a.out, exist_ok=True)
+    path = os.path.join(a.out, "summary.json")
+    summary = json.load(open(path)) if os.path.exists(path) else {}
+    summary["case"] = "yade-mpm (WLS-MPM, DP-GK) vs YADE JCFpm bonded particles: Sec. 3.3 uniaxial + Sec. 3.1 Kirsch"
+    if "kirsch" in a.parts:
+        kirsch_part(a, summary)
+        out.write_summary(a.out, summary)
+    if "uniaxial" in a.parts:
+        uniaxial_part(a, summary)
+        out.write_summary(a.out, summary)
+    log(f"wrote {path}")
+    return summary
+
+
+if __name__ == "__main__":
+    main()
