@@ -46,6 +46,11 @@ def disc_packing(lo, hi, r_mean, rel_fuzz=0.3, seed=1, cache_dir=None, fraction=
         if os.path.exists(path):
             return np.load(path)
     yade, O, pack, utils, w = _yade()
+    try:                                          # makeCloud warns that a flat box means 2D: that is the intent
+        from yade import log
+        log.setLevel("SpherePack", log.ERROR)
+    except Exception:
+        pass
     O.reset()
     # the cloud starts with radii shrunk by the growth factor of a ~0.42 cloud → fraction
     grow = math.sqrt(fraction / 0.42)
