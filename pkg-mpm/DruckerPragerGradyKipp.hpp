@@ -44,6 +44,22 @@ struct DpGkMat : ElasticMat {
 	}
 	// Eq. 37: ε_D⁰ = (V k)^(−1/m). V is the particle volume; in plane strain, area × 1 m.
 	Real activationStrain(Real volume) const { return std::pow(volume * weibullK, -1.0 / weibullM); }
+	// Eq. 37, refused outside (0, 1): V·k ≤ 1 (less than one flaw per particle) gives ε_D⁰ ≥ 1 and damage
+	// that can never start; an underflow to 0 would damage every particle at once.
+	Real threshold(Real volume) const
+	{
+		const Real e = activationStrain(volume);
+		if (!(e > 0 && e < 1))
+			throw InputError("damage threshold eps0 = (V·weibullK)^(−1/weibullM) = " + ParamInfo::num(e) + " for particle volume V = " + ParamInfo::num(volume)
+			                 + " m³ is outside the allowed range (0, 1) (weibullK = " + ParamInfo::num(weibullK) + " m^-3, weibullM = " + ParamInfo::num(weibullM)
+			                 + "; V·weibullK = " + ParamInfo::num(volume * weibullK) + " must exceed 1: at least one flaw per particle)");
+		return e;
+	}
+	void checkThresholds(const Real* volume, size_t n) const
+	{
+		for (size_t p = 0; p < n && damage; ++p)
+			if (volume[p] > 0 && volume[p] < INFINITY) threshold(volume[p]); // bad volumes are reported as such elsewhere
+	}
 };
 
 // Result of a single DP return, exposed for the single-particle tests.

@@ -116,6 +116,21 @@ struct Particles {
 		return c;
 	}
 
+	// DP–GK state written through the views (validated after requestSort()): D ∈ [0, 1], ε̄p finite
+	// and ≥ 0, and with damage on ε_D⁰ ∈ (0, 1) (Eq. 37); out-of-range values were used as they were.
+	void checkDamageState(bool thresholds) const
+	{
+		if (!hasDamageState()) return;
+		auto bad = [&](const char* what, size_t p, Real v, const char* range) {
+			throw InputError(std::string(what) + " of particle id " + std::to_string(id[p]) + " = " + fmtNum(v) + " is outside the allowed range " + range);
+		};
+		for (size_t p = 0; p < n; ++p) {
+			if (!(damage[p] >= 0 && damage[p] <= 1)) bad("damage D", p, damage[p], "[0, 1]");
+			if (!(epsP[p] >= 0 && std::isfinite(epsP[p]))) bad("plastic strain epsP", p, epsP[p], "[0, inf)");
+			if (thresholds && !(eps0[p] > 0 && eps0[p] < 1)) bad("damage threshold eps0", p, eps0[p], "(0, 1)");
+		}
+	}
+
 	Sym<D> stress(size_t p) const
 	{
 		Sym<D> s;

@@ -58,6 +58,7 @@ public:
 	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n)
 	{
 		const size_t old = P.n;
+		if (kind == MaterialKind::DruckerPragerGradyKipp) dpgk.checkThresholds(vol, n); // ε_D⁰ ∈ (0, 1) before anything is added
 		P.append(x, vol, mass, n, grid.origin, grid.upper());
 		if (kind == MaterialKind::DruckerPragerGradyKipp) {
 			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
@@ -75,6 +76,7 @@ public:
 	void setMaterial(const DpGkMat& m)
 	{
 		m.validate();
+		m.checkThresholds(P.vol0.data(), P.n); // ε_D⁰ ∈ (0, 1) before anything changes
 		dpgk    = m;
 		elastic = m;
 		kind    = MaterialKind::DruckerPragerGradyKipp;
@@ -256,7 +258,7 @@ private:
 	{
 		if (!dpgk.damage) return;
 		P.ensureDamageState();
-		for (size_t p = from; p < P.n; ++p) P.eps0[p] = dpgk.activationStrain(P.vol0[p]); // Eq. 37
+		for (size_t p = from; p < P.n; ++p) P.eps0[p] = dpgk.threshold(P.vol0[p]); // Eq. 37
 	}
 	void throwIf(const ErrorRecord& e, const char* phaseName) const
 	{
@@ -274,6 +276,7 @@ private:
 			// State edited through the live views (requestSort() after editing) is validated like
 			// addParticles input: a NaN or off-grid position would index outside the node arrays.
 			const auto c = P.check(grid.origin, grid.upper());
+			P.checkDamageState(kind == MaterialKind::DruckerPragerGradyKipp && dpgk.damage);
 			rhoMin       = c.rhoMin;
 			vmax         = std::max(vmax, c.vmax);
 			massFloor    = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)

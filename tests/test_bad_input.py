@@ -240,3 +240,53 @@ def test_face_traction_on_a_face_without_particles_refused():
 def test_scene_helpers_name_the_parameter(call, msg):
     with pytest.raises(ValueError, match=msg):
         call()
+
+
+# ---- DP–GK state written through the views: checked at the next step after requestSort()
+def _dpgk_block():
+    s = _solver()
+    ym.add_region(s, ym.rocks.granite_dpgk(), (0, 0), (1, 1))
+    s.run(2)
+    return s
+
+
+@pytest.mark.parametrize("field, value, msg", [
+    ("damage", 1.5, r"damage D of particle id {pid} = 1.5 is outside the allowed range \[0, 1\]"),
+    ("damage", -0.1, r"damage D of particle id {pid} = -0.1 is outside the allowed range \[0, 1\]"),
+    ("damage", np.nan, r"damage D of particle id {pid} = nan is outside"),
+    ("epsP", -1e-3, r"plastic strain epsP of particle id {pid} = -0.001 is outside the allowed range \[0, inf\)"),
+    ("epsP", np.inf, r"plastic strain epsP of particle id {pid} = inf is outside"),
+    ("eps0", 0.0, r"damage threshold eps0 of particle id {pid} = 0 is outside the allowed range \(0, 1\)"),
+    ("eps0", 2.0, r"damage threshold eps0 of particle id {pid} = 2 is outside the allowed range \(0, 1\)"),
+])
+def test_damage_state_out_of_range_through_views_refused(field, value, msg):
+    """These values were used as they were (D = 1.5 flips the sign of the tensile stress, eps0 = 0
+    damages at any tension)."""
+    s = _dpgk_block()
+    steps, t = s.steps, s.time
+    s.view(field)[11] = value
+    s.requestSort()
+    pid = int(s.view("id")[11])
+    with pytest.raises(ValueError, match=msg.format(pid=pid)):
+        s.step()
+    assert (s.steps, s.time) == (steps, t)            # refused before any work
+
+
+def test_damage_threshold_outside_unit_interval_refused():
+    """ε_D⁰ = (V k)^(−1/m) (Eq. 37) must lie in (0, 1): V·k < 1 means fewer than one flaw per particle and
+    a threshold strain above 100 % (damage can never start) — it was accepted silently."""
+    m = ym.rocks.granite_dpgk(weibullK=1e3)           # V k = (0.05 m)²·1 m · 1e3 = 2.5
+    assert 0 < m.activationStrain(2.5e-3) < 1
+    s = _solver()
+    ym.add_region(s, m, (0, 0), (1, 1))                # accepted: ε_D⁰ = 2.5^(−1/7.5) ≈ 0.885
+    assert s.view("eps0")[0] == pytest.approx(2.5 ** (-1 / 7.5), rel=1e-12)
+    low = ym.rocks.granite_dpgk(weibullK=100.0)       # V k = 0.25: ε_D⁰ = 0.25^(−1/7.5) ≈ 1.2
+    with pytest.raises(ValueError, match=r"damage threshold eps0 = .* = 1.2.* for particle volume V = 0.0025 m³ is outside "
+                                         r"the allowed range \(0, 1\) .*V·weibullK = 0.25 must exceed 1"):
+        s.setMaterial(low)
+    assert s.dpgkParameters().weibullK == 1e3          # refused before anything changed
+    s2 = _solver()
+    s2.setMaterial(low)                                # no particles yet: nothing to check
+    with pytest.raises(ValueError, match=r"V·weibullK = 0.25 must exceed 1"):
+        s2.addParticles(np.array([[0.5, 0.5]]), np.array([2.5e-3]), np.array([6.0]))
+    assert s2.numParticles == 0
