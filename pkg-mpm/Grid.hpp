@@ -47,7 +47,8 @@ struct Grid {
 	size_t stride[3];  // linear index strides
 	std::vector<Node<D>> nodes;
 	std::vector<uint8_t> fixMask;  // bit a set: velocity component a is prescribed zero
-	std::vector<uint8_t> excluded; // 1 = node excluded from WLS fits (ghosts always; user/contact mask)
+	std::vector<uint8_t> excluded; // non-zero = node excluded from WLS fits; bits: ExclUser (ghosts always, user mask), ExclContact
+	enum : uint8_t { ExclUser = 1, ExclContact = 2 };
 	std::vector<BoundaryPlane<D>> planes;
 
 	Grid() = default;
@@ -147,12 +148,20 @@ struct Grid {
 	{
 		if (i >= size()) throw InputError("node index " + std::to_string(i) + " is outside [0, " + std::to_string(size() - 1) + "]");
 		if (isGhost(i)) throw InputError("node index " + std::to_string(i) + " is a ghost node outside the physical grid");
-		if (bool(excluded[i]) == ex) return;
-		excluded[i] = ex ? 1 : 0;
+		if (bool(excluded[i] & ExclUser) == ex) return;
+		excluded[i] = ex ? (excluded[i] | ExclUser) : (excluded[i] & ~ExclUser);
 		nUserExcluded += ex ? 1 : -1;
 	}
-	bool userExclusions() const { return nUserExcluded > 0; }
-	long nUserExcluded = 0;
+	// Contact's own bit (a node covered by a rigid body, Fig. 1b), set and cleared every step by the contact
+	// phase without touching the user bit. No range check: the contact phase passes physical nodes only.
+	void setContactExcluded(size_t i, bool ex)
+	{
+		if (bool(excluded[i] & ExclContact) == ex) return;
+		excluded[i] = ex ? (excluded[i] | ExclContact) : (excluded[i] & ~ExclContact);
+		nContactExcluded += ex ? 1 : -1;
+	}
+	bool userExclusions() const { return nUserExcluded > 0 || nContactExcluded > 0; }
+	long nUserExcluded = 0, nContactExcluded = 0;
 };
 
 } // namespace mpm

@@ -294,6 +294,105 @@ struct SolverWrap {
 	{
 		s.grid.setExcluded(size_t(argInt(i, who("setNodeExcluded: node"), 0, double(s.grid.size() - 1))), argBool(ex, who("setNodeExcluded: excluded")));
 	}
+	// ---- rigid bodies for PTS contact (Sec. 2.3); the YADE adapter is py/yade_mpm/bodies.py
+	using MatD = typename Dim<D>::Mat;
+	using Spin = SpinOf<D>;
+	static MatD toMat(const bp::object& o, const char* name)
+	{
+		np::ndarray a = asDoubleArray(o, name, D, D);
+		MatD        m;
+		auto*       p = reinterpret_cast<double*>(a.get_data());
+		for (int i = 0; i < D; ++i)
+			for (int j = 0; j < D; ++j) m(i, j) = p[i * D + j];
+		return m;
+	}
+	static Spin toSpin(const bp::object& o, const char* name)
+	{
+		Spin w;
+		if constexpr (D == 2) {
+			w[0] = argReal(o, who(name) + " (ω_z)", "rad/s");
+		} else {
+			auto v = argReals(o, who(name), 3, "rad/s");
+			for (int a = 0; a < 3; ++a) w[a] = v[a];
+		}
+		return w;
+	}
+	static bp::object fromSpin(const Spin& w)
+	{
+		if constexpr (D == 2) return bp::object(w[0]);
+		else return bp::make_tuple(w[0], w[1], w[2]);
+	}
+	static int addRigidPart(S& s) { return s.contact.addPart(); }
+	static int addContactGroup(S& s, bp::object parts, bp::object mu, bp::object cohesion, bp::object chi, bp::object d0)
+	{
+		std::vector<int> ps;
+		for (long k = 0; k < bp::len(parts); ++k) ps.push_back(int(argInt(parts[k], who("addContactGroup: parts"), 0, 2147483647.0)));
+		ContactParams prm; // ranges checked by ContactParams::validate (one declaration)
+		prm.mu       = argReal(mu, who("addContactGroup: mu"), "-");
+		prm.cohesion = argReal(cohesion, who("addContactGroup: cohesion"), "Pa");
+		prm.chi      = argReal(chi, who("addContactGroup: chi"), "-");
+		prm.autoD0   = d0.is_none();
+		if (!prm.autoD0) prm.d0 = argReal(d0, who("addContactGroup: d0"), "m");
+		return s.contact.addGroup(prm, ps);
+	}
+	static void addContactBox(S& s, int g, int part, bp::object centre, bp::object rot, bp::object half)
+	{
+		s.contact.addBox(g, part, toVec<D>(centre, "box centre"), toMat(rot, "box rotation"), toVec<D>(half, "box half extents"));
+	}
+	static void addContactPlane(S& s, int g, int part, bp::object point, bp::object normal, bool twoSided)
+	{
+		s.contact.addPlane(g, part, toVec<D>(point, "plane point"), toVec<D>(normal, "plane normal"), twoSided);
+	}
+	static void addContactElement(S& s, int g, int part, bp::object verts)
+	{
+		np::ndarray a = asDoubleArray(verts, "element vertices", D, D);
+		auto*       p = reinterpret_cast<double*>(a.get_data());
+		typename Dim<D>::Vec v[D];
+		for (int k = 0; k < D; ++k)
+			for (int j = 0; j < D; ++j) v[k][j] = p[k * D + j];
+		s.contact.addElement(g, part, v);
+	}
+	static void setRigidPartState(S& s, int part, bp::object pos, bp::object rot, bp::object vel, bp::object angVel)
+	{
+		s.contact.part(part).setState(toVec<D>(pos, "rigid body position"), toMat(rot, "rigid body orientation"), toVec<D>(vel, "rigid body velocity"),
+		                              toSpin(angVel, "rigid body angular velocity"));
+	}
+	static bp::tuple rigidPartForce(S& s, int part) { return fromVec<D>(s.contact.part(part).force); }
+	static bp::object rigidPartTorque(S& s, int part) { return fromSpin(s.contact.part(part).torque); }
+	// Signed distance, outward normal and owning part of a contact group at a point (for tests and inspection).
+	static bp::tuple contactQuery(S& s, int g, bp::object point)
+	{
+		auto& grp = s.contact.group(g);
+		grp.update(s.contact.parts);
+		auto h = grp.query(toVec<D>(point, "point"));
+		return bp::make_tuple(h.d, fromVec<D>(h.n), h.part);
+	}
+	static bool contactGroupClosed(S& s, int g)
+	{
+		auto& grp = s.contact.group(g);
+		grp.update(s.contact.parts);
+		return grp.closed;
+	}
+	// Contact force each node received from the last group processed in the last step, (nodes, D) [N].
+	static np::ndarray contactNodeForces(S& s)
+	{
+		size_t      n   = s.grid.size();
+		np::ndarray out = np::zeros(bp::make_tuple(n, D), np::dtype::get_builtin<double>());
+		auto*       o   = reinterpret_cast<double*>(out.get_data());
+		if (s.contact.nodeArr.size() == n)
+			for (size_t i = 0; i < n; ++i)
+				for (int a = 0; a < D; ++a) o[i * D + a] = s.contact.nodeArr.force[a][i];
+		return out;
+	}
+	static np::ndarray excludedNodes(S& s)
+	{
+		size_t      n   = s.grid.size();
+		np::ndarray out = np::empty(bp::make_tuple(n), np::dtype::get_builtin<uint8_t>());
+		std::copy(s.grid.excluded.begin(), s.grid.excluded.end(), reinterpret_cast<uint8_t*>(out.get_data()));
+		return out;
+	}
+	static bool contactActive(S& s) { return s.contact.active(); }
+
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
 	// Settings are routed through one validating setter so every bad value raises ValueError.
@@ -328,6 +427,20 @@ struct SolverWrap {
 		        .def("nodePositions", &nodePositions)
 		        .def("nodeState", &nodeState)
 		        .def("setNodeExcluded", &setNodeExcluded, (bp::arg("node"), bp::arg("excluded")))
+		        .def("addRigidPart", &addRigidPart, "new rigid part (one YADE body or clump); returns its index")
+		        .def("addContactGroup", &addContactGroup, (bp::arg("parts"), bp::arg("mu"), bp::arg("cohesion"), bp::arg("chi"), bp::arg("d0")),
+		             "contact group over rigid parts with μ [-], c [Pa], χ [-], d0 [m] (None = ½ particle edge); returns its index")
+		        .def("addContactBox", &addContactBox, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("rotation"), bp::arg("half")))
+		        .def("addContactPlane", &addContactPlane, (bp::arg("group"), bp::arg("part"), bp::arg("point"), bp::arg("normal"), bp::arg("twoSided")))
+		        .def("addContactElement", &addContactElement, (bp::arg("group"), bp::arg("part"), bp::arg("vertices")))
+		        .def("setRigidPartState", &setRigidPartState, (bp::arg("part"), bp::arg("pos"), bp::arg("rot"), bp::arg("vel"), bp::arg("angVel")))
+		        .def("rigidPartForce", &rigidPartForce, bp::arg("part"))
+		        .def("rigidPartTorque", &rigidPartTorque, bp::arg("part"))
+		        .def("contactQuery", &contactQuery, (bp::arg("group"), bp::arg("point")))
+		        .def("contactGroupClosed", &contactGroupClosed, bp::arg("group"))
+		        .def("contactNodeForces", &contactNodeForces)
+		        .def("excludedNodes", &excludedNodes)
+		        .add_property("contactActive", &contactActive)
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("requestSort", &S::requestSort)

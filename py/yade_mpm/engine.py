@@ -7,7 +7,11 @@ iterPeriod=1 and initRun=True placed in O.engines like any engine:
 Each YADE iteration it advances the MPM particles by O.dt, lowering O.dt first when the MPM stable
 step requires it (and raising it back towards the step the user/DEM asked for when possible), so
 O.time and O.iter stay the simulation's clock. The PyRunner carries the label, and
-``yade_mpm.engine('mpm')`` returns this object from that label."""
+``yade_mpm.engine('mpm')`` returns this object from that label.
+
+With rigid bodies (``bodies``, a ``yade_mpm.RigidBodies``), each step reads their kinematics from
+O.bodies before the MPM step and adds the contact reactions to O.forces after it, so the PyRunner must
+come after ForceResetter and before NewtonIntegrator."""
 from .progress import Progress
 
 _registry = {}
@@ -24,9 +28,13 @@ def engine(label):
 
 
 class MpmEngine:
-    def __init__(self, solver, label="mpm", progress_interval=None, end_time=None):
+    def __init__(self, solver, label="mpm", progress_interval=None, end_time=None, bodies=None):
         """solver: a Solver2D/3D; label: YADE engine label; progress_interval: wall seconds between
-        progress lines (None = silent); end_time: simulated end time [s] for the ETA."""
+        progress lines (None = silent); end_time: simulated end time [s] for the ETA; bodies: the
+        RigidBodies in contact with the particles (None: no contact code runs)."""
+        if bodies is not None and getattr(bodies, "solver", None) is not solver:
+            raise ValueError("bodies must be a yade_mpm.RigidBodies built on this engine's solver")
+        self.bodies = bodies
         if not isinstance(label, str) or not label.isidentifier():
             raise ValueError(f"label = {label!r} must be a Python identifier (YADE exposes labels as names)")
         self.solver, self.label = solver, label
@@ -69,7 +77,11 @@ class MpmEngine:
             if dt != O.dt:
                 O.dt = dt
             self.last_set_dt = O.dt
+            if self.bodies is not None:
+                self.bodies.read()
             s.advance(O.dt)
+            if self.bodies is not None:
+                self.bodies.write()
         except Exception as e:  # stop YADE cleanly with the message instead of stepping on
             self.error = e
             O.pause()

@@ -1,0 +1,372 @@
+// Particle-to-surface (PTS) frictional contact between MPM particles and rigid surfaces (paper Sec. 2.3,
+// Eqs. 23–26; Wang & Chan 2014, Nakamura et al. 2021). Per step, for each contact group:
+//
+//   beforeTransfer   world geometry from the parts' poses; grid nodes covered by a body are marked
+//                    inactive (Grid contact bit, Fig. 1b), so particles near a body use WLS shape
+//                    functions fitted over the active nodes only.
+//   apply            (after gridUpdate, before g2p)
+//     1. particle pass: particles with d_p − d0 < 0 get the normal penalty force
+//        f_p = −(1 − χ) κ_p (d_p − d0) n_p, κ_p = 2 m_p/Δt² (Eq. 23), spread to the nodes with ψ_i;
+//        the node's share of the normal load N_i = Σ_p ŵ_i ‖f_p‖ and contact area A_i = Σ_p ŵ_i a_p
+//        (a_p = V_p^{(D−1)/D}, the particle's face) are spread with the non-negative B-spline weights
+//        normalised over the active nodes, ŵ_i = w_i / Σ_active w;
+//     2. node pass: relative velocity with the rigid body at the node, ṽ_i = v_i − (v + ω × (x_i − c))
+//        (Eq. 26), tangential part (Eq. 25), stick force f_stick = −m_i ṽ_tan/Δt, Coulomb limit
+//        μ N_i + A_i c (Eq. 24): stick below, slip at the limit; v_i += Δt (f_nor + f_tan)/m_i;
+//     3. reaction: the part owning the surface point nearest each node receives −(f_nor + f_tan) and
+//        its moment about the part's centre, summed in node order (exactly the opposite of what the
+//        grid received).
+//
+// N_i instead of ‖f_nor,i‖ in the limit: next to excluded nodes the WLS ψ_i are partly negative (a fit
+// over two node rows extrapolates), so Σ_i ‖Σ_p ψ_i f_p‖ exceeds the total normal force by up to a
+// factor 3 and the friction with it (measured: a block on a 30° incline with μ = 0.3 slid with 22 % too
+// little acceleration). Σ_i N_i is exactly the total normal force, so the body-level limit is μ N.
+// A_i: the paper takes A = l (2D) or the cell face area (3D) per contact node. With WLS over the active
+// nodes the contact of one surface layer of particles spreads over two or three node rows, so a constant
+// A per node would multiply the cohesive capacity by that (grid-offset dependent) row count; A_i as
+// defined above sums to l (2D) / l² (3D) per node column of a flat surface, i.e. the paper's value,
+// and Σ_i A_i is the contact area whatever the offset.
+//
+// Parallel and deterministic: the particle pass is a block-coloured scatter restricted to the blocks
+// near the group (same-colour blocks never share a node, each block summed by one thread in particle
+// order); the node pass is independent per node; the reaction is summed by one thread in node order.
+// Results are bitwise identical for any thread count. A solver without groups never calls any of it.
+#pragma once
+#include "BlockSchedule.hpp"
+#include "RigidSurface.hpp"
+#include "WlsShape.hpp"
+
+namespace mpm {
+
+// Per-node contact arrays in structure-of-arrays storage, kept outside Node<D> (one cache line of transfer
+// lanes). Allocated only when a scene has rigid bodies.
+template <int D>
+struct ContactNodes {
+	std::vector<Real> fn[D];    // normal force f_nor (Eq. 23) of the group being processed [N]
+	std::vector<Real> force[D]; // total contact force applied to the node by that group in the last step [N]
+	std::vector<Real> load;     // normal load share N_i = Σ_p ŵ_i ‖f_p‖ for the Coulomb limit [N]
+	std::vector<Real> area;     // contact area A_i = Σ_p ŵ_i a_p [m²] (2D: m per m)
+	size_t            size() const { return area.size(); }
+	void              resize(size_t n)
+	{
+		for (int a = 0; a < D; ++a) fn[a].assign(n, 0), force[a].assign(n, 0);
+		load.assign(n, 0), area.assign(n, 0);
+	}
+};
+
+template <int D>
+class PtsContact {
+public:
+	using Vec  = typename Dim<D>::Vec;
+	using IVec = typename Dim<D>::IVec;
+	static constexpr int N = Dim<D>::nStencil;
+
+	std::vector<RigidPart<D>>  parts;
+	std::vector<RigidGroup<D>> groups;
+
+	bool active() const { return !groups.empty(); }
+
+	int addPart()
+	{
+		parts.emplace_back();
+		return int(parts.size()) - 1;
+	}
+	// A group of already-added parts with its contact parameters; primitives are added to the returned index.
+	int addGroup(const ContactParams& prm, const std::vector<int>& ps)
+	{
+		prm.validate();
+		if (ps.empty()) throw InputError("a contact group needs at least one rigid part");
+		for (int p : ps)
+			if (p < 0 || p >= int(parts.size())) throw InputError("rigid part index " + std::to_string(p) + " does not exist");
+		RigidGroup<D> g;
+		g.params = prm;
+		g.parts  = ps;
+		groups.push_back(g);
+		work.emplace_back();
+		return int(groups.size()) - 1;
+	}
+	RigidGroup<D>& group(int g)
+	{
+		if (g < 0 || g >= int(groups.size())) throw InputError("contact group " + std::to_string(g) + " does not exist");
+		return groups[g];
+	}
+	RigidPart<D>& part(int p)
+	{
+		if (p < 0 || p >= int(parts.size())) throw InputError("rigid part " + std::to_string(p) + " does not exist");
+		return parts[p];
+	}
+	void checkPart(const RigidGroup<D>& g, int p) const
+	{
+		if (std::find(g.parts.begin(), g.parts.end(), p) == g.parts.end())
+			throw InputError("rigid part " + std::to_string(p) + " is not a part of this contact group");
+	}
+	void addBox(int gi, int p, const Vec& cL, const typename Dim<D>::Mat& RL, const Vec& h)
+	{
+		auto& g = group(gi);
+		checkPart(g, p);
+		for (int a = 0; a < D; ++a) requireRange(h[a], 0, INFINITY, true, true, "box half extent", "[m]"), requireFinite(cL[a], "box centre");
+		g.boxes.push_back({ p, cL, h, RL, cL, RL });
+	}
+	void addPlane(int gi, int p, const Vec& pL, const Vec& nL, bool twoSided)
+	{
+		auto& g = group(gi);
+		checkPart(g, p);
+		for (int a = 0; a < D; ++a) requireFinite(pL[a], "plane point"), requireFinite(nL[a], "plane normal");
+		if (!(nL.norm() > 0)) throw InputError("plane normal must be non-zero");
+		g.planes.push_back({ p, pL, nL.normalized(), twoSided, pL, nL.normalized() });
+	}
+	// Segment (2D) or triangle (3D): D vertices in the part frame.
+	void addElement(int gi, int p, const Vec* v)
+	{
+		auto& g = group(gi);
+		checkPart(g, p);
+		for (int k = 0; k < D; ++k)
+			for (int a = 0; a < D; ++a) requireFinite(v[k][a], "surface element vertex");
+		Real size = D == 2 ? (v[1] - v[0]).norm() : (v[1] - v[0]).norm() + (v[2] - v[0]).norm();
+		if (!(size > 0)) throw InputError("surface element is degenerate (zero length or area)");
+		for (int k = 0; k < D; ++k) g.elemL.push_back(v[k]), g.elem.push_back(v[k]);
+		g.elemPart.push_back(p);
+		g.topologyKnown = false;
+	}
+
+	ContactNodes<D>     nodeArr; // per-node contact arrays (sized to the grid by the first step with bodies)
+	std::vector<size_t> marked; // nodes carrying the contact exclusion bit
+
+	// ---------------------------------------------------------------- before P2G (serial)
+	// World geometry, reaction reset, covered nodes excluded, per-group node/block ranges.
+	void beforeTransfer(Grid<D>& grid, const BlockSchedule<D>& sched)
+	{
+		ensureArrays(grid);
+		for (size_t i : marked) grid.setContactExcluded(i, false);
+		marked.clear();
+		for (auto& q : parts) q.force.setZero(), q.torque.setZero();
+		const Real l    = grid.spacing;
+		const Real band = (2 * std::sqrt(Real(D)) + 0.5) * l; // deepest node a particle outside the body can reach
+		for (size_t gi = 0; gi < groups.size(); ++gi) {
+			auto& g  = groups[gi];
+			auto& wk = work[gi];
+			g.update(parts);
+			const Real reach = (g.params.autoD0 ? 1.5 * l : g.params.d0 + l); // detection margin outside the surface
+			Vec        lo, hi;
+			// nodes covered by the body (within `band` of the surface)
+			g.bounds(0, band, lo, hi);
+			IVec nlo, nhi;
+			if (nodeRange(grid, lo, hi, nlo, nhi))
+				forNodes(grid, nlo, nhi, [&](size_t i) {
+					if (grid.excluded[i] & Grid<D>::ExclContact) return;
+					Real d = g.query(grid.position(i)).d;
+					if (d < 0 && d > -band) {
+						grid.setContactExcluded(i, true);
+						marked.push_back(i);
+					}
+				});
+			// particles that may touch, and the nodes their stencils reach
+			g.bounds(reach, band, lo, hi);
+			wk.skip = !blockRange(grid, sched, lo, hi, wk.blo, wk.bhi);
+			Vec slo = lo - Vec::Constant(2 * l), shi = hi + Vec::Constant(2 * l);
+			wk.skip = wk.skip || !nodeRange(grid, slo, shi, wk.nlo, wk.nhi);
+			wk.reach = reach;
+		}
+	}
+
+	// ---------------------------------------------------------------- after gridUpdate (every thread of the region)
+	template <class ErrorRecord>
+	void apply(Grid<D>& grid, const Particles<D>& P, const BlockSchedule<D>& sched, const StencilOffsets<D>& offs, Real dt, Real massFloor,
+	           ErrorRecord& err)
+	{
+		auto& A = nodeArr;
+		for (size_t gi = 0; gi < groups.size(); ++gi) {
+			const auto& g  = groups[gi];
+			const auto& wk = work[gi];
+			if (wk.skip) continue;
+			const size_t nn = boxCount(wk.nlo, wk.nhi);
+#pragma omp for schedule(static)
+			for (size_t j = 0; j < nn; ++j) {
+				size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+				for (int a = 0; a < D; ++a) A.fn[a][i] = 0, A.force[a][i] = 0;
+				A.area[i] = A.load[i] = 0;
+			}
+			// 1. normal penalty force of the contacted particles, Eq. 23
+			const Real chi = g.params.chi, twoOverDt2 = 2.0 / (dt * dt);
+			for (int c = 0; c < Dim<D>::nColours; ++c) {
+				IVec first, cnt;
+				size_t nb = 1;
+				for (int a = 0; a < D; ++a) {
+					const int par = (c >> a) & 1;
+					first[a]      = wk.blo[a] + ((par - wk.blo[a]) % 2 + 2) % 2;
+					cnt[a]        = first[a] > wk.bhi[a] ? 0 : (wk.bhi[a] - first[a]) / 2 + 1;
+					nb *= size_t(cnt[a]);
+				}
+#pragma omp for schedule(dynamic, 1)
+				for (size_t k = 0; k < nb; ++k) {
+					size_t r = k, b = 0, s = 1;
+					for (int a = 0; a < D; ++a) {
+						b += size_t(first[a] + 2 * int(r % cnt[a])) * s;
+						r /= cnt[a];
+						s *= sched.nBlocks[a];
+					}
+					for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) {
+						Vec x;
+						for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+						const Real d0 = g.params.autoD0 ? 0.5 * edgeOf(P.vol[p]) : g.params.d0;
+						if (d0 > wk.reach) continue; // beyond the detection margin (documented limit)
+						const auto h = g.query(x);
+						if (!(h.d - d0 < 0)) continue;
+						Stencil<D> st;
+						if (!computeStencil(grid, offs, x.data(), st)) {
+							err.record(p, "is in contact with a rigid body but has too few active grid nodes for the WLS fit (penetrated the body?)");
+							continue;
+						}
+						const Real fmag = (1 - chi) * P.mass[p] * twoOverDt2 * (d0 - h.d); // Eq. 23, κ_p = 2 m_p/Δt²
+						const Vec  fp   = fmag * h.n;
+						const Real ap   = P.vol[p] / edgeOf(P.vol[p]); // face of the particle
+						Real       wsum = 0;                          // B-spline weights over the active nodes
+						for (int n = 0; n < N; ++n) wsum += st.w[n];
+						const Real wn = 1 / wsum;
+						for (int n = 0; n < N; ++n) {
+							if (st.w[n] == 0) continue;
+							const size_t i = st.base + offs.off[n];
+							for (int a = 0; a < D; ++a) A.fn[a][i] += st.psi[n] * fp[a]; // Eq. 23
+							A.load[i] += st.w[n] * wn * fmag;
+							A.area[i] += st.w[n] * wn * ap;
+						}
+					}
+				}
+			}
+			// 2. stick / slip per node, Eqs. 24–26
+			const Real mu = g.params.mu, coh = g.params.cohesion;
+			const bool onePart = g.parts.size() == 1;
+#pragma omp for schedule(static)
+			for (size_t j = 0; j < nn; ++j) {
+				const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+				Vec          fn;
+				for (int a = 0; a < D; ++a) fn[a] = A.fn[a][i];
+				const Real fnorm = fn.norm();
+				auto&      nd    = grid.nodes[i];
+				if (fnorm == 0 || !(nd.m > massFloor)) continue;
+				const Vec xi = grid.position(i);
+				const int pi = onePart ? g.parts[0] : g.query(xi).part;
+				const Vec nrm = fn / fnorm;
+				Vec       v;
+				for (int a = 0; a < D; ++a) v[a] = nd.a[a];
+				Vec rel = v + (dt / nd.m) * fn - parts[pi].velocityAt(xi); // Eq. 26
+				Vec vt  = rel - rel.dot(nrm) * nrm;                        // Eq. 25
+				Vec ft  = (-nd.m / dt) * vt;                               // f_stick
+				const Real fmax = mu * A.load[i] + A.area[i] * coh; // Coulomb limit of Eq. 24
+				const Real fs   = ft.norm();
+				if (fs >= fmax) ft *= fs > 0 ? fmax / fs : 0; // Eq. 24: slip at the Coulomb limit
+				const Vec     f   = fn + ft;
+				const uint8_t fix = grid.fixMask[i];
+				for (int a = 0; a < D; ++a) {
+					nd.a[a]     = (fix >> a) & 1 ? 0.0 : v[a] + dt * f[a] / nd.m;
+					A.force[a][i]  = f[a];
+				}
+			}
+			// 3. reaction on the parts: minus the nodal contact forces, in node order
+#pragma omp single
+			{
+				for (size_t j = 0; j < nn; ++j) {
+					const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+					Vec          f;
+					for (int a = 0; a < D; ++a) f[a] = A.force[a][i];
+					if (f.isZero(0)) continue;
+					const Vec xi = grid.position(i);
+					auto&     q  = parts[onePart ? g.parts[0] : g.query(xi).part];
+					q.force -= f;
+					q.torque -= momentOf<D>(xi - q.c, f);
+				}
+			}
+		}
+	}
+
+private:
+	struct Work {
+		bool skip = true;
+		IVec blo, bhi; // block coordinate range of the particle pass
+		IVec nlo, nhi; // stored node coordinate range of the node pass
+		Real reach = 0;
+	};
+	std::vector<Work> work;
+
+	static Real edgeOf(Real vol)
+	{
+		if constexpr (D == 2) return std::sqrt(vol);
+		else return std::cbrt(vol);
+	}
+	void ensureArrays(const Grid<D>& grid)
+	{
+		const size_t n = grid.size();
+		if (nodeArr.size() == n) return;
+		nodeArr.resize(n);
+		marked.reserve(1024);
+	}
+	// Stored coordinates of the physical nodes within [lo, hi]; false when empty.
+	static bool nodeRange(const Grid<D>& grid, const Vec& lo, const Vec& hi, IVec& nlo, IVec& nhi)
+	{
+		const int gh = Grid<D>::ghost;
+		for (int a = 0; a < D; ++a) {
+			Real fl = (lo[a] - grid.origin[a]) / grid.spacing, fh = (hi[a] - grid.origin[a]) / grid.spacing;
+			fl      = std::max(fl, Real(0)), fh = std::min(fh, Real(grid.cells[a]));
+			if (!(fl <= fh)) return false;
+			nlo[a] = int(std::ceil(fl)) + gh, nhi[a] = int(std::floor(fh)) + gh;
+			if (nlo[a] > nhi[a]) return false;
+		}
+		return true;
+	}
+	// Block coordinates whose particles may lie within [lo, hi]; false when none holds particles.
+	static bool blockRange(const Grid<D>& grid, const BlockSchedule<D>& s, const Vec& lo, const Vec& hi, IVec& blo, IVec& bhi)
+	{
+		constexpr int B = BlockSchedule<D>::B, M = BlockSchedule<D>::margin;
+		for (int a = 0; a < D; ++a) {
+			Real fl = (lo[a] - grid.origin[a]) / grid.spacing - M, fh = (hi[a] - grid.origin[a]) / grid.spacing + M;
+			fl      = std::max(fl, Real(0)), fh = std::min(fh, Real(grid.cells[a]));
+			if (!(fl <= fh)) return false;
+			blo[a] = std::min(int(fl) / B, s.nBlocks[a] - 1), bhi[a] = std::min(int(fh) / B, s.nBlocks[a] - 1);
+		}
+		bool any = false;
+		IVec bl = blo, bh = bhi;
+		forBox(bl, bh, [&](const IVec& c) {
+			size_t b = 0, st = 1;
+			for (int a = 0; a < D; ++a) b += size_t(c[a]) * st, st *= s.nBlocks[a];
+			any = any || s.start[b] != s.start[b + 1];
+		});
+		return any;
+	}
+	template <class F>
+	static void forBox(const IVec& lo, const IVec& hi, F&& f)
+	{
+		IVec c = lo;
+		while (true) {
+			f(c);
+			int a = 0;
+			for (; a < D; ++a) {
+				if (++c[a] <= hi[a]) break;
+				c[a] = lo[a];
+			}
+			if (a == D) return;
+		}
+	}
+	template <class F>
+	static void forNodes(const Grid<D>& grid, const IVec& lo, const IVec& hi, F&& f)
+	{
+		forBox(lo, hi, [&](const IVec& c) { f(grid.linear(c)); });
+	}
+	static size_t boxCount(const IVec& lo, const IVec& hi)
+	{
+		size_t n = 1;
+		for (int a = 0; a < D; ++a) n *= size_t(hi[a] - lo[a] + 1);
+		return n;
+	}
+	static size_t boxNode(const Grid<D>& grid, const IVec& lo, const IVec& hi, size_t j)
+	{
+		size_t i = 0;
+		for (int a = 0; a < D; ++a) {
+			const size_t w = size_t(hi[a] - lo[a] + 1);
+			i += size_t(lo[a] + int(j % w)) * grid.stride[a];
+			j /= w;
+		}
+		return i;
+	}
+};
+
+} // namespace mpm
