@@ -41,7 +41,11 @@ inline SpinOf<D> momentOf(const typename Dim<D>::Vec& r, const typename Dim<D>::
 struct ContactParams {
 	Real mu       = 0;    // Coulomb friction coefficient μ_con [-], ≥ 0
 	Real cohesion = 0;    // contact cohesion c_con [Pa], ≥ 0
-	Real chi      = 0;    // residual penetration factor χ [-], 0 ≤ χ < 1 (0 = no residual penetration)
+	// residual penetration factor χ [-], 0 ≤ χ < 1. Default ½: positions advance with the updated velocity
+	// (x += Δt v^{n+1}), so (1 − χ) κ = m/Δt² takes a penetrating particle back to d0 in exactly one step;
+	// χ = 0 pushes it out by twice its penetration (the contact layer is reflected; measured +15 % total
+	// energy at the first contact of a 3D block dropped on a wall, none with χ = ½).
+	Real chi      = 0.5;
 	Real d0       = 0;    // detection distance d0 [m], ≥ 0; used when autoD0 is false
 	bool autoD0   = true; // d0 = ½ V_p^{1/D}: half the particle's edge, i.e. contact when the particle's face touches
 	void validate() const
@@ -232,7 +236,7 @@ private:
 			return Vec(-t[1], t[0]).normalized();
 		} else return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
 	}
-	// Inside test of a closed element set: crossing parity (2D), generalised winding number (3D).
+	// Inside test of a closed element set: crossing parity of a ray (2D: along +x; 3D: three skew rays).
 	bool inside(const Vec& x) const
 	{
 		if constexpr (D == 2) {
@@ -245,17 +249,35 @@ private:
 				}
 			}
 			return in;
-		} else {
-			Real w = 0; // Σ solid angles / 4π (Van Oosterom & Strackee)
-			for (size_t e = 0; e < elemPart.size(); ++e) {
-				Vec  a = elem[3 * e] - x, b = elem[3 * e + 1] - x, c = elem[3 * e + 2] - x;
-				Real la = a.norm(), lb = b.norm(), lc = c.norm();
-				Real num = a.dot(b.cross(c));
-				Real den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-				w += 2 * std::atan2(num, den);
+		} else { // ray crossing parity, independent of the triangles' orientation; majority of 3 skew rays
+			static const Vec dirs[3] = { Vec(0.5366, 0.6358, 0.5547).normalized(), Vec(-0.7071, 0.3141, 0.6330).normalized(),
+				                     Vec(0.2718, -0.8284, 0.4899).normalized() };
+			int votes = 0;
+			for (const auto& r : dirs) {
+				bool in = false;
+				for (size_t e = 0; e < elemPart.size(); ++e)
+					if (rayHits(x, r, elem[3 * e], elem[3 * e + 1], elem[3 * e + 2])) in = !in;
+				votes += in;
 			}
-			return std::abs(w) > 2 * M_PI; // |winding number| > ½
+			return votes >= 2;
 		}
+	}
+	// Möller–Trumbore: does the ray x + t r (t > 0) cross triangle (a, b, c)?
+	static bool rayHits(const Vec& x, const Vec& r, const Vec& a, const Vec& b, const Vec& c)
+	{
+		if constexpr (D == 3) {
+			const Vec  e1 = b - a, e2 = c - a, p = r.cross(e2);
+			const Real det = e1.dot(p);
+			if (std::abs(det) < 1e-300) return false;
+			const Real inv = 1 / det;
+			const Vec  s   = x - a;
+			const Real u   = s.dot(p) * inv;
+			if (u < 0 || u > 1) return false;
+			const Vec  q = s.cross(e1);
+			const Real v = r.dot(q) * inv;
+			if (v < 0 || u + v > 1) return false;
+			return e2.dot(q) * inv > 0;
+		} else return false;
 	}
 	void meshQuery(const Vec& x, Hit& h) const
 	{

@@ -505,6 +505,18 @@ bp::tuple dpgkPointUpdate(bp::object matO, bp::object stress, bp::object strainI
 // (100000: a step segfaulted; 1000: libgomp aborted).
 int maxThreads() { return std::max(16, 4 * omp_get_num_procs()); }
 void setThreads(bp::object n) { omp_set_num_threads(int(argInt(n, "setThreads: threads", 1, maxThreads()))); }
+// Defaults of the contact parameters (one declaration: ContactParams in RigidSurface.hpp); d0 None = ½ particle edge.
+bp::dict contactDefaults()
+{
+	ContactParams p;
+	bp::dict      d;
+	d["mu"]       = p.mu;
+	d["cohesion"] = p.cohesion;
+	d["chi"]      = p.chi;
+	d["d0"]       = p.autoD0 ? bp::object() : bp::object(p.d0);
+	return d;
+}
+
 int getThreads() { return omp_get_max_threads(); }
 
 } // namespace
@@ -546,5 +558,6 @@ BOOST_PYTHON_MODULE(_core)
 	bp::def("dpgkPointUpdate2D", &dpgkPointUpdate<2>, pointArgs, pointDoc);
 	bp::def("dpgkPointUpdate3D", &dpgkPointUpdate<3>, pointArgs, pointDoc);
 	bp::def("setThreads", &setThreads, bp::arg("threads"), "Number of OpenMP threads, in [1, max(16, 4 × processors)].");
+	bp::def("contactDefaults", &contactDefaults, "Defaults of the contact parameters mu [-], cohesion [Pa], chi [-], d0 [m] (None = half the particle edge).");
 	bp::def("getThreads", &getThreads);
 }

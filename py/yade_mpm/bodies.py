@@ -28,16 +28,19 @@ per metre of the plane-strain slice: its dynamics match the MPM side for any t. 
 Contact parameters (defaults and units; each validated with its range before any step):
   mu        Coulomb friction coefficient μ_con [-], ≥ 0; default 0 (frictionless)
   cohesion  contact cohesion c_con [Pa], ≥ 0; default 0
-  chi       residual penetration factor χ [-], 0 ≤ χ < 1; default 0 (no residual penetration)
+  chi       residual penetration factor χ [-], 0 ≤ χ < 1; default ½: with positions advanced by the
+            updated velocity, (1 − χ)·2m/Δt² = m/Δt² takes a penetrating particle back to d0 in one step
+            (χ = 0 reflects the contact layer and gained 15 % energy at a 3D impact)
   d0        detection distance d0 [m], ≥ 0; default None = ½ V_p^{1/D}, half the particle's own edge:
             a particle stands for a cell of edge V_p^{1/D} centred on it, so contact starts when that
             cell's face reaches the surface (for ppc = 2 this is a quarter of the grid spacing).
 """
 import numpy as np
 
+from . import _core
 from .scene import dim_of
 
-CONTACT_DEFAULTS = dict(mu=0.0, cohesion=0.0, chi=0.0, d0=None)
+CONTACT_DEFAULTS = dict(_core.contactDefaults())   # declared once, in ContactParams (RigidSurface.hpp)
 
 
 def _check_params(mu, cohesion, chi, d0, thickness):
@@ -189,7 +192,7 @@ class RigidBodies:
     def write(self):
         """Contact reactions of the last MPM step into O.forces (2D: per-metre values × thickness)."""
         from yade import O
-        from minieigen import Vector3
+        from yade import Vector3
         s = self.solver
         for bid, part, t in self._parts:
             f, m = s.rigidPartForce(part), s.rigidPartTorque(part)
