@@ -1,20 +1,11 @@
 // C++ unit tests of the core that need no Python: WLS shape functions against the closed form and
 // linear reproduction, and one DP return landing on the yield surface.
 #include "Solver.hpp"
+#include "Check.hpp"
 #include <cstdio>
 #include <random>
 
 using namespace mpm;
-static int failures = 0;
-#define CHECK(cond, ...)                                                                                                                             \
-	do {                                                                                                                                         \
-		if (!(cond)) {                                                                                                                       \
-			std::printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                                             \
-			std::printf(__VA_ARGS__);                                                                                                    \
-			std::printf("\n");                                                                                                           \
-			++failures;                                                                                                                  \
-		}                                                                                                                                    \
-	} while (0)
 
 template <int D>
 void shapeChecks()

@@ -3,20 +3,11 @@
 // computations), planes, open surfaces, closedness detection, and the rigid velocity v + ω × (x − c)
 // against a finite difference of the moving body.
 #include "RigidSurface.hpp"
+#include "Check.hpp"
 #include <cstdio>
 #include <random>
 
 using namespace mpm;
-static int failures = 0;
-#define CHECK(cond, ...)                                                                                                                             \
-	do {                                                                                                                                         \
-		if (!(cond)) {                                                                                                                       \
-			std::printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                                             \
-			std::printf(__VA_ARGS__);                                                                                                    \
-			std::printf("\n");                                                                                                           \
-			++failures;                                                                                                                  \
-		}                                                                                                                                    \
-	} while (0)
 
 template <int D>
 typename Dim<D>::Mat rotation(Real a, Real b)
