@@ -97,8 +97,11 @@ struct SolverWrap {
 	}
 	static void setForces(S& s, bp::object idx, bp::object forces)
 	{
-		np::ndarray i = np::from_object(idx, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
-		if (i.get_nd() != 1) throw InputError("particle indices must be a 1-D integer array");
+		bp::object  raw  = bp::import("numpy").attr("asarray")(idx);
+		std::string kind = bp::extract<std::string>(raw.attr("dtype").attr("kind"));
+		if (bp::len(raw.attr("shape")) != 1 || (kind != "i" && kind != "u" && bp::len(raw) > 0))
+			throw InputError(who("setParticleForces: indices") + " must be a 1-D array of integer particle slots (got " + pyTypeName(idx.ptr()) + " " + pyRepr(idx) + ")");
+		np::ndarray i = np::from_object(raw, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
 		size_t      n = i.shape(0);
 		np::ndarray f = asDoubleArray(forces, "forces", D, n);
 		auto*       ip = reinterpret_cast<int64_t*>(i.get_data());

@@ -290,3 +290,20 @@ def test_damage_threshold_outside_unit_interval_refused():
     with pytest.raises(ValueError, match=r"V·weibullK = 0.25 must exceed 1"):
         s2.addParticles(np.array([[0.5, 0.5]]), np.array([2.5e-3]), np.array([6.0]))
     assert s2.numParticles == 0
+
+
+@pytest.mark.parametrize("call, msg", [
+    (lambda: _solver().setParticleForces(np.zeros(1), [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
+    (lambda: _solver().setParticleForces(10 ** 20, [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
+    (lambda: ym.make_solver((0, 0), (1, 1), True), r"spacing must be a number \[m\] \(got bool True\)"),
+    (lambda: ym.get(None, "pos"), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
+    (lambda: ym.MpmEngine(None), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
+    (lambda: ym.Progress(np.nan), r"Progress end_time = nan s is outside"),
+    (lambda: ym.Progress(-1.0), r"Progress end_time = -1.0 s is outside the allowed range \[0, inf\)"),
+    (lambda: ym.Progress(1.0, interval=-1), r"Progress interval = -1 s is outside the allowed range \[0, inf\)"),
+])
+def test_more_public_calls_name_the_parameter(call, msg):
+    """Found by calling every public function with wrong types/NaN/inf/negatives/empty arrays/wrong
+    shapes: these were an OverflowError/AttributeError, or accepted (bool spacing 1 m, NaN end time)."""
+    with pytest.raises(ValueError, match=msg):
+        call()

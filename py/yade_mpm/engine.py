@@ -32,6 +32,8 @@ class MpmEngine:
         """solver: a Solver2D/3D; label: YADE engine label; progress_interval: wall seconds between
         progress lines (None = silent); end_time: simulated end time [s] for the ETA; bodies: the
         RigidBodies in contact with the particles (None: no contact code runs)."""
+        from .scene import dim_of
+        dim_of(solver)                                    # ValueError unless a Solver2D/Solver3D
         if bodies is not None and getattr(bodies, "solver", None) is not solver:
             raise ValueError("bodies must be a yade_mpm.RigidBodies built on this engine's solver")
         self.bodies = bodies

@@ -7,6 +7,8 @@ import numpy as np
 def _number(v, name, unit, positive=False):
     """A finite float (> 0 if positive) or ValueError naming the parameter, unit and range."""
     try:
+        if isinstance(v, (bool, np.bool_, str, bytes)):
+            raise TypeError
         f = float(v)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number [{unit}] (got {type(v).__name__} {v!r})") from None

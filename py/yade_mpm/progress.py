@@ -8,6 +8,13 @@ class Progress:
     The ETA comes from the fraction done of `end_time` [s] (simulated), or else of `total_steps`."""
 
     def __init__(self, end_time, label="mpm", interval=10.0, stream=sys.stdout, total_steps=None):
+        from .geometry import _integer, _number
+        if end_time is not None and _number(end_time, "Progress end_time", "s") < 0:
+            raise ValueError(f"Progress end_time = {end_time} s is outside the allowed range [0, inf) (or None)")
+        if _number(interval, "Progress interval", "s") < 0:
+            raise ValueError(f"Progress interval = {interval} s is outside the allowed range [0, inf)")
+        if total_steps is not None:
+            _integer(total_steps, "Progress total_steps", 0)
         self.end_time, self.label, self.interval, self.stream = end_time, label, interval, stream
         self.total_steps = total_steps
         self.start = time.time()

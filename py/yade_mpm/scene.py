@@ -70,8 +70,8 @@ def get(solver, name, order=None):
     """Copy of a particle field in particle-id order. Names: pos, vel, stress (the stress carried,
     damaged for DP–GK; components xx, yy, zz, xy[, xz, yz], tension positive, [Pa]), state_stress,
     max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass, volume, id."""
-    o = _order(solver) if order is None else order   # pass order=id_order(solver) when reading many fields
     d = dim_of(solver)
+    o = _order(solver) if order is None else order   # pass order=id_order(solver) when reading many fields
     if name == "pos":
         return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
     if name == "vel":
