@@ -1,12 +1,13 @@
 // The two particle phases that close a step (paper Fig. 2): the constitutive update from the MUSL
 // velocity gradient, then the position update with the stability and re-sort checks.
 #pragma once
+#include "MaterialSet.hpp"
 #include "Transfer.hpp"
 
 namespace mpm {
 
 // Velocity gradient from the MUSL nodal velocities (Eq. 7), strain increment (Eq. 29), Jaumann rotation,
-// material update (Eqs. 27–40), volume V ← det(I + Δt∇v) V. Returns the smallest density m/V (for Δt).
+// material update (Eqs. 27–40), volume V ← det(I + Δt∇v) V. Returns the smallest dtDensity (for Δt).
 // Failures (singular fit, non-finite stress, inverted volume) are recorded in err; the caller throws.
 template <int D, class Mat>
 inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRecord& err)
@@ -42,7 +43,7 @@ inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRe
 				err.record(p, what);
 				continue;
 			}
-			rmin = std::min(rmin, P.mass[p] / P.vol[p]);
+			rmin = std::min(rmin, dtDensity(mat, P, p)); // ρ (one material) or ρ/M (mixed), for Δt
 		}
 	return rmin;
 }

@@ -19,6 +19,7 @@ struct Particles {
 	std::vector<Real> vol0;     // initial V_p [m³]
 	std::vector<Real> sig[NS];  // Cauchy stress (undamaged state) [Pa], tension positive
 	std::vector<int64_t> id;    // stable particle id (the insertion order)
+	std::vector<uint8_t> mat;   // material index (MaterialSet.hpp)
 
 	// Optional fields, empty unless a scene uses them.
 	std::vector<Real> trac[D]; // prescribed surface force on the particle (traction × area) [N]
@@ -58,7 +59,7 @@ struct Particles {
 	// Appends n particles (positions x[p·D + a] [m], volumes [m³], masses [kg]) after checking every value;
 	// the grid spans [lo, hi). Throws InputError naming the particle and quantity, before any change.
 	template <class Vec>
-	void append(const Real* x, const Real* vol, const Real* mass, size_t n, const Vec& lo, const Vec& hi)
+	void append(const Real* x, const Real* vol, const Real* mass, size_t n, const Vec& lo, const Vec& hi, uint8_t material)
 	{
 		if (n == 0) throw InputError("particles: the particle set to add is empty");
 		for (size_t p = 0; p < n; ++p) {
@@ -78,6 +79,7 @@ struct Particles {
 		this->n += n;
 		forEachRealField([&](std::vector<Real>& f) { f.resize(this->n, 0.0); });
 		id.resize(this->n);
+		this->mat.resize(this->n, material);
 		for (size_t p = 0; p < n; ++p) {
 			for (int a = 0; a < D; ++a) this->x[a][old + p] = x[p * D + a];
 			this->vol[old + p] = vol0[old + p] = vol[p];
@@ -91,7 +93,7 @@ struct Particles {
 		Real rhoMin = INFINITY, massMin = INFINITY, vmax = 0;
 	};
 	template <class Vec>
-	Summary check(const Vec& lo, const Vec& hi) const
+	Summary check(const Vec& lo, const Vec& hi, size_t nMaterials) const
 	{
 		Summary c;
 		for (size_t p = 0; p < n; ++p) {
@@ -102,6 +104,8 @@ struct Particles {
 					                 + " m is not finite or outside the grid [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m");
 			if (!(std::isfinite(mass[p]) && mass[p] > 0)) throw InputError("mass of " + who() + " = " + fmtNum(mass[p]) + " kg must be finite and > 0");
 			if (!(std::isfinite(vol[p]) && vol[p] > 0)) throw InputError("volume of " + who() + " = " + fmtNum(vol[p]) + " m³ must be finite and > 0");
+			if (mat[p] >= nMaterials)
+				throw InputError("material of " + who() + " = " + std::to_string(mat[p]) + " is not a material index of this solver [0, " + std::to_string(nMaterials - 1) + "]");
 			c.rhoMin  = std::min(c.rhoMin, mass[p] / vol[p]);
 			c.massMin = std::min(c.massMin, mass[p]);
 			Real sp   = 0;
@@ -118,7 +122,8 @@ struct Particles {
 
 	// DP–GK state written through the views (validated after requestSort()): D ∈ [0, 1], ε̄p finite
 	// and ≥ 0, and with damage on ε_D⁰ ∈ (0, 1) (Eq. 37); out-of-range values were used as they were.
-	void checkDamageState(bool thresholds) const
+	template <class ThresholdOn>
+	void checkDamageState(ThresholdOn&& thresholds) const // thresholds(p): check ε_D⁰ of particle p
 	{
 		if (!hasDamageState()) return;
 		auto bad = [&](const char* what, size_t p, Real v, const char* range) {
@@ -127,7 +132,7 @@ struct Particles {
 		for (size_t p = 0; p < n; ++p) {
 			if (!(damage[p] >= 0 && damage[p] <= 1)) bad("damage D", p, damage[p], "[0, 1]");
 			if (!(epsP[p] >= 0 && std::isfinite(epsP[p]))) bad("plastic strain epsP", p, epsP[p], "[0, inf)");
-			if (thresholds && !(eps0[p] > 0 && eps0[p] < 1)) bad("damage threshold eps0", p, eps0[p], "(0, 1)");
+			if (thresholds(p) && !(eps0[p] > 0 && eps0[p] < 1)) bad("damage threshold eps0", p, eps0[p], "(0, 1)");
 		}
 	}
 
@@ -152,12 +157,14 @@ struct Particles {
 			std::copy(tmp.begin(), tmp.begin() + n, a.begin());
 		});
 		idTmp.resize(n);
+		for (size_t k = 0; k < n; ++k) idTmp[k] = mat[perm[k]];
+		for (size_t k = 0; k < n; ++k) mat[k] = uint8_t(idTmp[k]);
 		for (size_t k = 0; k < n; ++k) idTmp[k] = id[perm[k]];
 		std::copy(idTmp.begin(), idTmp.begin() + n, id.begin()); // keep the buffer: Python views must stay valid
 	}
 	size_t bytesPerParticle() const
 	{
-		size_t b = sizeof(int64_t);
+		size_t b = sizeof(int64_t) + sizeof(uint8_t);
 		const_cast<Particles*>(this)->forEachRealField([&](std::vector<Real>&) { b += sizeof(Real); });
 		return b;
 	}

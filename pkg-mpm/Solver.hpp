@@ -10,14 +10,12 @@
 //   moveParticles  positions, stability and re-sort checks                            ParticleUpdate.hpp
 #pragma once
 #include "ContactPhase.hpp"
-#include "DruckerPragerGradyKipp.hpp"
 #include "GridUpdate.hpp"
+#include "MaterialSet.hpp"
 #include "ParticleUpdate.hpp"
 #include <omp.h>
 
 namespace mpm {
-
-enum class MaterialKind : int { None = -1, Elastic = 0, DruckerPragerGradyKipp = 1 };
 
 // Wall time per phase [s], summed over steps (for the benchmark); stress includes moveParticles.
 struct PhaseTimes {
@@ -55,37 +53,47 @@ public:
 	Solver& operator=(const Solver&) = delete;
 
 	// ---------------------------------------------------------------- set-up
-	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n)
+	// Particles of material index `material` (addMaterial's return value; 0 = the material of setMaterial).
+	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n, long material = 0)
 	{
+		materials.checkIndex(material);
 		const size_t old = P.n;
-		if (kind == MaterialKind::DruckerPragerGradyKipp) dpgk.checkThresholds(vol, n); // ε_D⁰ ∈ (0, 1) before anything is added
-		P.append(x, vol, mass, n, grid.origin, grid.upper());
-		if (kind == MaterialKind::DruckerPragerGradyKipp) {
+		if (materials.size() && materials[size_t(material)].kind == MaterialKind::DruckerPragerGradyKipp)
+			materials[size_t(material)].dpgk.checkThresholds(vol, n); // ε_D⁰ ∈ (0, 1) before anything is added
+		P.append(x, vol, mass, n, grid.origin, grid.upper(), uint8_t(material));
+		if (materials.anyDpgk()) {
 			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
-			initDamageThresholds(old);
+			materials.initDamageThresholds(P, old);
 		}
 		needSort = needCheck = true;
 	}
-
-	void setMaterial(const ElasticMat& m)
+	// A further material for particles added with addParticles(…, material = index); returns the index.
+	template <class Mat>
+	size_t addMaterial(const Mat& m)
 	{
-		m.validate();
-		elastic = m;
-		kind    = MaterialKind::Elastic;
+		const size_t i = materials.add(m);
+		if (materials.anyDpgk() && P.n) P.ensureDamageState(), materials.initDamageThresholds(P, 0);
+		needCheck = true; // the time step's density measure depends on the material set
+		return i;
 	}
-	void setMaterial(const DpGkMat& m)
+	// One-material scenes (older scripts): sets material 0, or replaces it and recomputes every particle's
+	// damage threshold. A scene with several materials refuses (it would silently change other regions).
+	template <class Mat>
+	void setMaterial(const Mat& m)
 	{
+		if (materials.size() == 0) return void(addMaterial(m));
+		if (!materials.single())
+			throw InputError("setMaterial: this solver holds " + std::to_string(materials.size())
+			                 + " materials; setMaterial replaces the only material of a one-material scene — use addMaterial and addParticles(…, material=index)");
 		m.validate();
-		m.checkThresholds(P.vol0.data(), P.n); // ε_D⁰ ∈ (0, 1) before anything changes
-		dpgk    = m;
-		elastic = m;
-		kind    = MaterialKind::DruckerPragerGradyKipp;
-		P.ensureDamageState();
-		initDamageThresholds(0);
+		if constexpr (std::is_same_v<Mat, DpGkMat>) m.checkThresholds(P.vol0.data(), P.n); // ε_D⁰ ∈ (0, 1) before anything changes
+		if constexpr (std::is_same_v<Mat, DpGkMat>) materials.replaceFirst({ MaterialKind::DruckerPragerGradyKipp, ElasticMat(m), m });
+		else materials.replaceFirst({ MaterialKind::Elastic, m, DpGkMat {} });
+		if (materials.anyDpgk() && P.n) P.ensureDamageState(), materials.initDamageThresholds(P, 0);
+		needCheck = true;
 	}
-	MaterialKind      materialKind() const { return kind; }
-	const ElasticMat& elasticParameters() const { return elastic; }
-	const DpGkMat&    dpgkParameters() const { return dpgk; }
+	const MaterialSet<D>& materialSet() const { return materials; }
+	MaterialKind          materialKind() const { return materials.size() ? materials[0].kind : MaterialKind::None; } // of material 0
 
 	void addBoundaryPlane(int axis, int side, Real position, BoundaryKind k) { grid.addPlane({ axis, side, position, k }); }
 
@@ -110,8 +118,12 @@ public:
 	}
 
 	// ---------------------------------------------------------------- time step
-	// Characteristic P-wave speed v_c = √((K + 4G/3)/ρ_min) [m/s].
-	Real waveSpeed() const { return std::sqrt(elastic.pWaveModulus() / rhoMin); }
+	// Characteristic P-wave speed v_c = max over materials of √((K + 4G/3)/ρ_min) [m/s].
+	Real waveSpeed()
+	{
+		prepare();
+		return materials.waveSpeed(rhoMin);
+	}
 	// Paper's stability condition Δt = C·l/(v_c + max‖v‖) with the current particle velocities.
 	Real stableDt()
 	{
@@ -142,7 +154,7 @@ public:
 		const Vec  g = gravity;
 		const Real s = loadScale(time);
 		double     t[6] = { omp_get_wtime() };
-		withMaterial([&](const auto& mat) {
+		materials.dispatch([&](const auto& mat) {
 			// The grid phases share one parallel region (a thread team is woken once per step, which matters
 			// on shared cores); every thread takes the same branches after the barrier ending each phase.
 #pragma omp parallel
@@ -191,23 +203,29 @@ public:
 			for (int a = 0; a < D; ++a) e += 0.5 * P.mass[p] * P.v[a][p] * P.v[a][p];
 		return e;
 	}
-	// Elastic energy stored by the (effective) stress, Σ V (s:s/(4G) + σm²/(2K)) [J].
+	// Elastic energy stored by the (effective) stress, Σ V (s:s/(4G) + σm²/(2K)) with each particle's K, G [J].
 	Real elasticEnergy() const
 	{
-		const Real K = elastic.bulk(), G = elastic.shear();
-		Real       e = 0;
+		Real e = 0;
 		for (size_t p = 0; p < P.n; ++p) {
-			Sym<D> s  = effectiveStress(p);
-			Real   sm = s.toDeviator();
-			e += P.vol[p] * (s.contract() / (4 * G) + sm * sm / (2 * K));
+			const ElasticMat& m  = materials.of(P, p).elastic;
+			Sym<D>            s  = effectiveStress(p);
+			Real              sm = s.toDeviator();
+			e += P.vol[p] * (s.contract() / (4 * m.shear()) + sm * sm / (2 * m.bulk()));
 		}
 		return e;
 	}
 	// The stress the particle carries: the damaged stress for DP–GK (Eq. 40), else the state.
 	Sym<D> effectiveStress(size_t p) const
 	{
-		if (kind == MaterialKind::DruckerPragerGradyKipp) return DruckerPragerGradyKipp<D>::damaged(P.stress(p), P.damage[p]);
+		if (materials.of(P, p).kind == MaterialKind::DruckerPragerGradyKipp) return DruckerPragerGradyKipp<D>::damaged(P.stress(p), P.damage[p]);
 		return P.stress(p);
+	}
+	// Current cohesion of a DP–GK particle (Eq. 34) [Pa]; NaN for other materials.
+	Real cohesion(size_t p) const
+	{
+		const auto& e = materials.of(P, p);
+		return e.kind == MaterialKind::DruckerPragerGradyKipp ? e.dpgk.cohesionAt(P.epsP[p]) : NAN;
 	}
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
 	Real maxSpeed() const { return vmax; }
@@ -233,9 +251,7 @@ public:
 	}
 
 private:
-	MaterialKind     kind = MaterialKind::None;
-	ElasticMat       elastic;
-	DpGkMat          dpgk;
+	MaterialSet<D>   materials;
 	BlockSchedule<D> sched;
 	Transfer<D>      xfer;               // the transfers, bound to grid, P and sched
 	bool             needSort  = true;   // particles must be re-sorted by block before the next transfer
@@ -248,18 +264,6 @@ private:
 #pragma omp master
 		t = omp_get_wtime();
 	}
-	template <class F>
-	void withMaterial(F&& f)
-	{
-		if (kind == MaterialKind::Elastic) f(LinearElastic<D>(elastic));
-		else f(DruckerPragerGradyKipp<D>(dpgk));
-	}
-	void initDamageThresholds(size_t from)
-	{
-		if (!dpgk.damage) return;
-		P.ensureDamageState();
-		for (size_t p = from; p < P.n; ++p) P.eps0[p] = dpgk.threshold(P.vol0[p]); // Eq. 37
-	}
 	void throwIf(const ErrorRecord& e, const char* phaseName) const
 	{
 		if (e.none()) return;
@@ -271,13 +275,16 @@ private:
 	void prepare()
 	{
 		if (P.n == 0) throw InputError("particles: no particles in the solver; add particles before stepping");
-		if (kind == MaterialKind::None) throw InputError("material: no material assigned; set a material before stepping");
+		if (materials.size() == 0) throw InputError("material: no material assigned; set a material before stepping");
 		if (!std::isfinite(rhoMin) || needCheck) {
 			// State edited through the live views (requestSort() after editing) is validated like
 			// addParticles input: a NaN or off-grid position would index outside the node arrays.
-			const auto c = P.check(grid.origin, grid.upper());
-			P.checkDamageState(kind == MaterialKind::DruckerPragerGradyKipp && dpgk.damage);
-			rhoMin       = c.rhoMin;
+			const auto c = P.check(grid.origin, grid.upper(), materials.size());
+			P.checkDamageState([&](size_t p) { // ε_D⁰ is checked where the particle's material has damage on
+				const auto& e = materials.of(P, p);
+				return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
+			});
+			rhoMin       = materials.single() ? c.rhoMin : materials.minDtDensity(P);
 			vmax         = std::max(vmax, c.vmax);
 			massFloor    = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)
 			needCheck    = false;

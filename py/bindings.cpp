@@ -77,23 +77,68 @@ struct SolverWrap {
 			                 + ParamInfo::num(phys / 1e9) + " GB of memory; use fewer cells or a larger spacing");
 		return std::make_shared<S>(o, h, n);
 	}
-	static void setMaterial(S& s, bp::object m)
+	// Calls f(material) with the ElasticMat or DpGkMat inside m, or refuses m naming `what`.
+	template <class F>
+	static auto withMat(bp::object m, const char* what, F&& f)
 	{
 		bp::extract<const DpGkMat&> dp(m);
-		if (dp.check()) return s.setMaterial(dp());
+		if (dp.check()) return f(dp());
 		bp::extract<const ElasticMat&> el(m);
-		if (el.check()) return s.setMaterial(el());
-		throw InputError(who("setMaterial: material") + " must be an ElasticMat or a DpGkMat (got " + pyTypeName(m.ptr()) + ")");
+		if (el.check()) return f(el());
+		throw InputError(who(what) + " must be an ElasticMat or a DpGkMat (got " + pyTypeName(m.ptr()) + ")");
+	}
+	static void setMaterial(S& s, bp::object m)
+	{
+		withMat(m, "setMaterial: material", [&](const auto& mat) { s.setMaterial(mat); });
+	}
+	static size_t addMaterial(S& s, bp::object m)
+	{
+		return withMat(m, "addMaterial: material", [&](const auto& mat) { return s.addMaterial(mat); });
+	}
+	static size_t materialIndex(S& s, bp::object i, const char* what)
+	{
+		if (s.materialSet().size() == 0) throw InputError(who(what) + ": this solver has no material yet (setMaterial or addMaterial first)");
+		return size_t(argInt(i, who(what), 0, double(s.materialSet().size() - 1)));
+	}
+	// Copy of material i as the Python object it was given as (ElasticMat or DpGkMat).
+	static bp::object material(S& s, bp::object i)
+	{
+		const auto& e = s.materialSet()[materialIndex(s, i, "material: index")];
+		if (e.kind == MaterialKind::DruckerPragerGradyKipp) return bp::object(std::make_shared<DpGkMat>(e.dpgk));
+		return bp::object(std::make_shared<ElasticMat>(e.elastic));
+	}
+	static ElasticMat elasticParameters(S& s, bp::object i) { return s.materialSet()[materialIndex(s, i, "elasticParameters: material")].elastic; }
+	static DpGkMat    dpgkParameters(S& s, bp::object i)
+	{
+		const auto& e = s.materialSet()[materialIndex(s, i, "dpgkParameters: material")];
+		if (e.kind != MaterialKind::DruckerPragerGradyKipp) throw InputError(who("dpgkParameters") + ": material is not a DpGkMat (use material(index))");
+		return e.dpgk;
+	}
+	static size_t    numMaterials(S& s) { return s.materialSet().size(); }
+	static bp::tuple materialKinds(S& s)
+	{
+		bp::list l;
+		for (size_t i = 0; i < s.materialSet().size(); ++i) l.append(int(s.materialSet()[i].kind));
+		return bp::tuple(l);
+	}
+	static np::ndarray cohesion(S& s)
+	{
+		np::ndarray out = np::empty(bp::make_tuple(s.P.n), np::dtype::get_builtin<double>());
+		auto*       o   = reinterpret_cast<double*>(out.get_data());
+		for (size_t p = 0; p < s.P.n; ++p) o[p] = s.cohesion(p);
+		return out;
 	}
 	static void advance(S& s, bp::object dt) { s.advance(argReal(dt, who("advance: dt"), "s", 0, INFINITY, OO)); }
 	static Real loadScale(S& s, bp::object t) { return s.loadScale(argReal(t, who("loadScale: t"), "s")); }
-	static void addParticles(S& s, bp::object pos, bp::object vol, bp::object mass)
+	static void addParticles(S& s, bp::object pos, bp::object vol, bp::object mass, bp::object matO)
 	{
+		const long mat = long(argInt(matO, who("addParticles: material (index from addMaterial)"), 0, 255));
+		s.materialSet().checkIndex(mat);
 		np::ndarray x = asDoubleArray(pos, "positions", D);
 		size_t      n = x.shape(0);
 		np::ndarray v = asDoubleArray(vol, "volumes", 0, n);
 		np::ndarray m = asDoubleArray(mass, "masses", 0, n);
-		s.addParticles(reinterpret_cast<double*>(x.get_data()), reinterpret_cast<double*>(v.get_data()), reinterpret_cast<double*>(m.get_data()), n);
+		s.addParticles(reinterpret_cast<double*>(x.get_data()), reinterpret_cast<double*>(v.get_data()), reinterpret_cast<double*>(m.get_data()), n, mat);
 	}
 	static void setForces(S& s, bp::object idx, bp::object forces)
 	{
@@ -148,6 +193,8 @@ struct SolverWrap {
 		if (name == "epsP") f = &P.epsP;
 		if (name == "damage") f = &P.damage;
 		if (name == "eps0") f = &P.eps0;
+		if (name == "material") // checked at the next step (requestSort); ε_D⁰ (eps0) is not recomputed
+			return np::from_data(P.mat.data(), np::dtype::get_builtin<uint8_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(uint8_t)), self);
 		if (name == "id")
 			return np::from_data(P.id.data(), np::dtype::get_builtin<int64_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(int64_t)), self);
 		if (!f) throw InputError("unknown particle field '" + name + "'");
@@ -412,7 +459,11 @@ struct SolverWrap {
 	{
 		bp::class_<S, std::shared_ptr<S>, boost::noncopyable>(name, "Explicit WLS-MPM solver (MUSL) on a fixed regular grid.", bp::no_init)
 		        .def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"))))
-		        .def("addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses")))
+		        .def("addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses"), bp::arg("material") = 0),
+		             "Adds particles (positions (N, D) [m], volumes [m³], masses [kg]) of material index `material` (addMaterial's return value).")
+		        .def("addMaterial", &addMaterial, bp::arg("material"), "Adds an ElasticMat or DpGkMat to the scene; returns its index for addParticles.")
+		        .def("material", &material, bp::arg("index"), "Copy of material `index` (ElasticMat or DpGkMat).")
+		        .def("cohesion", &cohesion, "Current cohesion per particle (Eq. 34) [Pa], storage order; NaN for non-DP–GK particles.")
 		        .def("setMaterial", &setMaterial, bp::arg("material"))
 		        .def("addBoundaryPlane", &addPlane, (bp::arg("axis"), bp::arg("side"), bp::arg("position"), bp::arg("kind")))
 		        .def("setParticleForces", &setForces, (bp::arg("indices"), bp::arg("forces")))
@@ -449,12 +500,14 @@ struct SolverWrap {
 		        .def("requestSort", &S::requestSort)
 		        .def("getResumeState", &getResumeState)
 		        .def("setResumeState", &setResumeState, bp::arg("state"))
-		        .def("elasticParameters", &S::elasticParameters, bp::return_value_policy<bp::copy_const_reference>())
-		        .def("dpgkParameters", &S::dpgkParameters, bp::return_value_policy<bp::copy_const_reference>())
+		        .def("elasticParameters", &elasticParameters, bp::arg("index") = 0)
+		        .def("dpgkParameters", &dpgkParameters, bp::arg("index") = 0)
 		        .def("loadScale", &loadScale, bp::arg("t"))
 		        .add_property("numParticles", &numParticles)
 		        .add_property("bytesPerParticle", &bytesPerParticle)
-		        .add_property("materialKind", &materialKind)
+		        .add_property("materialKind", &materialKind, "kind of material 0: 0 elastic, 1 DP–GK, -1 none (see materialKinds)")
+		        .add_property("materialKinds", &materialKinds, "kind of every material, by index: 0 elastic, 1 DP–GK")
+		        .add_property("numMaterials", &numMaterials)
 		        .add_property("spacing", &getSpacing)
 		        .add_property("origin", &getOrigin)
 		        .add_property("cells", &getCells)

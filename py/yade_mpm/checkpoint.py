@@ -92,6 +92,7 @@ def _particle_arrays(solver):
         raise CheckpointError(f"the core holds {nreal} particle arrays but the checkpoint knows {len(out)} "
                               f"({', '.join(out)}); update yade_mpm.checkpoint._field_names")
     out["id"] = solver.view("id")
+    out["material"] = solver.view("material")    # material index per particle (uint8), follows the sort like id
     return out
 
 
@@ -113,14 +114,13 @@ def solver_fingerprint(solver):
     arrs = _particle_arrays(solver)
     order = np.argsort(arrs["id"], kind="stable")
     loads = [arrs[f"trac{a}"][order] for a in range(dim_of(solver)) if f"trac{a}" in arrs]
-    kind = solver.materialKind
-    mat = solver.dpgkParameters() if kind == 1 else solver.elasticParameters()
     return {"dim": dim_of(solver), "origin": list(solver.origin), "spacing": solver.spacing,
             "cells": list(solver.cells), "particles": int(solver.numParticles),
-            "arrays": sorted(k for k in arrs if k != "id"),
+            "arrays": sorted(k for k in arrs if k not in ("id", "material")),
             "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
-            "loads": _digest(*loads) if loads else None, "materialKind": int(kind),
-            "material": _material_dict(mat)}
+            "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver.materialKinds],
+            "materials": [_material_dict(solver.material(i)) for i in range(solver.numMaterials)],
+            "material_index": _digest(arrs["material"][order])}
 
 
 def _solver_state(solver):

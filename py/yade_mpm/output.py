@@ -58,15 +58,20 @@ def particle_fields(solver):
         fields[f"stress_{c}"] = st[:, k]
     fields["max_principal_stress"] = field("max_principal_stress")
     fields["max_tensile_principal_stress"] = np.maximum(fields["max_principal_stress"], 0.0)
-    if solver.materialKind == 1:
+    mat_index = field("material").astype(np.int64)
+    if solver.numMaterials > 1:
+        fields["material"] = mat_index            # index into solver.material(i)
+    if 1 in solver.materialKinds:                 # some material is DP–GK
         fields["damage"] = field("damage")
         fields["plastic_strain"] = field("plastic_strain")
         fields["cohesion"] = field("cohesion")
         # crack indicators used by the paper's figures: tensile crack = fully damaged particle,
-        # shear crack = plastic strain past the softening end (cohesion at its 0.1 c0 floor)
-        m = solver.dpgkParameters()
+        # shear crack = plastic strain past the softening end (cohesion at its 0.1 c0 floor), per material
+        mats = [solver.material(i) for i in range(solver.numMaterials)]
+        end = np.array([(1 - m.residualCohesion) * m.critPlasticStrain if k == 1 else np.inf
+                        for m, k in zip(mats, solver.materialKinds)])
         fields["tensile_crack"] = (fields["damage"] >= 1.0).astype(np.int64)
-        fields["shear_crack"] = (fields["plastic_strain"] >= (1 - m.residualCohesion) * m.critPlasticStrain).astype(np.int64)
+        fields["shear_crack"] = (fields["plastic_strain"] >= end[mat_index]).astype(np.int64)
     return pos, fields
 
 

@@ -29,16 +29,28 @@ def dim_of(solver):
 
 
 def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None):
-    """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2);
-    assigns the material to the solver. Returns the storage indices range start (particle ids)."""
+    """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2).
+    Each region keeps its own material (several materials per scene, e.g. rock with an elastic infill):
+    the material is added to the solver (an identical one already there is reused) and the damage
+    thresholds of the new particles follow from it. Returns the ids of the new particles."""
     d = dim_of(solver)
     if np.ndim(lo) != 1 or len(lo) != d:
         raise ValueError(f"region lo = {lo} must have {d} components for a {d}D solver")
     x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
     first = solver.numParticles
-    solver.setMaterial(material)
-    solver.addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density))
+    index = material_index(solver, material)
+    solver.addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
     return np.arange(first, first + len(x))
+
+
+def material_index(solver, material):
+    """Index of `material` in the solver: an identical material (same type and parameters) already added
+    is reused, else it is added (solver.addMaterial)."""
+    for i in range(solver.numMaterials):
+        m = solver.material(i)
+        if type(m) is type(material) and m.toDict() == material.toDict():
+            return i
+    return solver.addMaterial(material)
 
 
 def views(solver):
@@ -47,7 +59,7 @@ def views(solver):
     changes when particles are re-sorted; `id` tells which particle sits in each slot."""
     d = dim_of(solver)
     names = [f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
-    names += ["mass", "vol", "vol0", "id", "epsP", "damage", "eps0"]
+    names += ["mass", "vol", "vol0", "id", "material", "epsP", "damage", "eps0"]
     out = {}
     for n in names:
         try:
@@ -87,11 +99,11 @@ def get(solver, name, order=None):
     if name == "plastic_strain":
         return _optional(solver, "epsP")[o]
     if name == "cohesion":
-        if solver.materialKind != 1:
+        if 1 not in solver.materialKinds:
             raise ValueError("cohesion exists only for the DP–GK material")
-        m = solver.dpgkParameters()
-        eps = _optional(solver, "epsP")[o]
-        return np.maximum(m.cohesion * (1 - eps / m.critPlasticStrain), m.residualCohesion * m.cohesion)  # Eq. 34
+        return solver.cohesion()[o]  # Eq. 34 with each particle's material; NaN for other materials
+    if name == "material":
+        return solver.view("material")[o].copy()
     if name == "mass":
         return solver.view("mass")[o].copy()
     if name == "volume":

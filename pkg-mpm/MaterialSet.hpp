@@ -1,0 +1,129 @@
+// Several materials per scene (e.g. DP–GK rock with an elastic grout infill, or two rock layers).
+// Particle p has the material index P.mat[p] (uint8, up to 256 materials). The hot loops stay templated
+// on the material kernel: a one-material scene runs LinearElastic<D> or DruckerPragerGradyKipp<D> as a
+// compile-time single-material path (exactly the code of a one-material solver); a mixed scene runs
+// MixedMaterial<D>, which switches on the particle's index into the same templated kernels (no virtual
+// calls). The stable time step uses the largest P-wave speed over the materials, each with the lowest
+// current density among its own particles.
+#pragma once
+#include "DruckerPragerGradyKipp.hpp"
+
+namespace mpm {
+
+enum class MaterialKind : int { None = -1, Elastic = 0, DruckerPragerGradyKipp = 1 };
+
+template <int D>
+struct MixedMaterial {
+	uint8_t                                kind[256] = {}; // MaterialKind of material index m
+	uint8_t                                slot[256] = {}; // position of m's kernel in el or dp
+	Real                                   modulus[256] = {}; // P-wave modulus K + 4G/3 [Pa]
+	std::vector<LinearElastic<D>>          el;
+	std::vector<DruckerPragerGradyKipp<D>> dp;
+
+	void update(Particles<D>& P, size_t p, Sym<D>& s, const Sym<D>& de, Real dt) const
+	{
+		const uint8_t m = P.mat[p];
+		if (kind[m] == uint8_t(MaterialKind::Elastic)) el[slot[m]].update(P, p, s, de, dt);
+		else dp[slot[m]].update(P, p, s, de, dt);
+	}
+	Sym<D> forceStress(const Particles<D>& P, size_t p) const
+	{
+		const uint8_t m = P.mat[p];
+		return kind[m] == uint8_t(MaterialKind::Elastic) ? el[slot[m]].forceStress(P, p) : dp[slot[m]].forceStress(P, p);
+	}
+};
+
+// Density measure whose minimum sets the time step: v_c = √(M / min dtDensity) for a single material
+// (dtDensity = ρ = m/V), v_c = √(1 / min dtDensity) for a mixed scene (dtDensity = ρ/M of the particle's
+// own material), i.e. v_c = max over materials of √(M_k/ρ_min,k).
+template <class Mat, int D>
+inline Real dtDensity(const Mat&, const Particles<D>& P, size_t p) { return P.mass[p] / P.vol[p]; }
+template <int D>
+inline Real dtDensity(const MixedMaterial<D>& m, const Particles<D>& P, size_t p) { return P.mass[p] / P.vol[p] / m.modulus[P.mat[p]]; }
+
+template <int D>
+class MaterialSet {
+public:
+	struct Entry {
+		MaterialKind kind;
+		ElasticMat   elastic; // the elastic part (every material has one)
+		DpGkMat      dpgk;    // valid when kind is DruckerPragerGradyKipp
+	};
+
+	size_t       size() const { return list.size(); }
+	bool         single() const { return list.size() == 1; }
+	const Entry& operator[](size_t i) const { return list.at(i); }
+	bool         anyDpgk() const
+	{
+		for (const auto& e : list)
+			if (e.kind == MaterialKind::DruckerPragerGradyKipp) return true;
+		return false;
+	}
+	size_t add(const ElasticMat& m) { return push({ MaterialKind::Elastic, (m.validate(), m), DpGkMat {} }); }
+	size_t add(const DpGkMat& m) { return push({ MaterialKind::DruckerPragerGradyKipp, (m.validate(), ElasticMat(m)), m }); }
+	void   replaceFirst(const Entry& e)
+	{
+		list.at(0) = e;
+		rebuild();
+	}
+	// Material index given through the public API: an integer in [0, size()) (0 allowed before any material exists).
+	void checkIndex(long i) const
+	{
+		if (i < 0 || (i >= long(list.size()) && !(i == 0 && list.empty())))
+			throw InputError("material = " + std::to_string(i) + " is not a material index of this solver: allowed range [0, " + std::to_string(long(list.size()) - 1)
+			                 + "] (addMaterial returns the index)");
+	}
+
+	// Calls f(kernel) once: the single-material kernel for a one-material scene, else the mixed one.
+	template <class F>
+	void dispatch(F&& f) const
+	{
+		if (!single()) return f(mixed);
+		if (list[0].kind == MaterialKind::Elastic) f(LinearElastic<D>(list[0].elastic));
+		else f(DruckerPragerGradyKipp<D>(list[0].dpgk));
+	}
+	// v_c from the minimum of dtDensity (see above) [m/s].
+	Real waveSpeed(Real minDtDensity) const { return std::sqrt((single() ? list[0].elastic.pWaveModulus() : 1.0) / minDtDensity); }
+	Real minDtDensity(const Particles<D>& P) const
+	{
+		Real r = INFINITY;
+		dispatch([&](const auto& k) {
+			for (size_t p = 0; p < P.n; ++p) r = std::min(r, dtDensity(k, P, p));
+		});
+		return r;
+	}
+	const Entry& of(const Particles<D>& P, size_t p) const { return list[P.mat[p]]; }
+	// Eq. 37 thresholds ε_D⁰ for particles [from, n) whose material is DP–GK with damage on.
+	void initDamageThresholds(Particles<D>& P, size_t from) const
+	{
+		for (size_t p = from; p < P.n; ++p) {
+			const Entry& e = of(P, p);
+			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage) P.eps0[p] = e.dpgk.threshold(P.vol0[p]);
+		}
+	}
+
+private:
+	std::vector<Entry> list;
+	MixedMaterial<D>   mixed; // kernels of a mixed scene, rebuilt when the list changes (never while stepping)
+
+	size_t push(const Entry& e)
+	{
+		if (list.size() >= 256) throw InputError("addMaterial: a solver holds at most 256 materials (particle material index is 8-bit)");
+		list.push_back(e);
+		rebuild();
+		return list.size() - 1;
+	}
+	void rebuild()
+	{
+		mixed.el.clear(), mixed.dp.clear();
+		for (size_t i = 0; i < list.size(); ++i) {
+			const Entry& e     = list[i];
+			mixed.kind[i]      = uint8_t(e.kind);
+			mixed.modulus[i]   = e.elastic.pWaveModulus();
+			if (e.kind == MaterialKind::Elastic) mixed.slot[i] = uint8_t(mixed.el.size()), mixed.el.emplace_back(e.elastic);
+			else mixed.slot[i] = uint8_t(mixed.dp.size()), mixed.dp.emplace_back(e.dpgk);
+		}
+	}
+};
+
+} // namespace mpm
