@@ -115,6 +115,17 @@ public:
 		if (!(nL.norm() > 0)) throw InputError("plane normal must be non-zero");
 		g.planes.push_back({ p, pL, nL.normalized(), twoSided, pL, nL.normalized() });
 	}
+	// Sphere (3D) / circle (2D) of radius r [m] centred at cL in the part frame.
+	void addSphere(int gi, int p, const Vec& cL, Real r)
+	{
+		auto& g = group(gi);
+		checkPart(g, p);
+		for (int a = 0; a < D; ++a) requireFinite(cL[a], "sphere centre");
+		requireRange(r, 0, INFINITY, true, true, "sphere radius", "[m]");
+		g.spheres.push_back({ p, cL, r, cL });
+	}
+	// Groups switched off are skipped whole (no geometry update, no particle or node pass).
+	void setEnabled(int gi, bool on) { group(gi).enabled = on; }
 	// Segment (2D) or triangle (3D): D vertices in the part frame.
 	void addElement(int gi, int p, const Vec* v)
 	{
@@ -145,6 +156,10 @@ public:
 		for (size_t gi = 0; gi < groups.size(); ++gi) {
 			auto& g  = groups[gi];
 			auto& wk = work[gi];
+			if (!g.enabled) {
+				wk.skip = true;
+				continue;
+			}
 			g.update(parts);
 			const Real reach = (g.params.autoD0 ? 1.5 * l : g.params.d0 + l); // detection margin outside the surface
 			Vec        lo, hi;

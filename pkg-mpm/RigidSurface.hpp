@@ -3,6 +3,8 @@
 // receives), its shape is a set of primitives expressed in the part's own frame:
 //   BoxPrim    oriented box (2D: rectangle, the trace of a box at z = 0)
 //   PlanePrim  plane; one-sided (half-space behind the normal, a YADE Wall with sense ±1) or two-sided
+//   SpherePrim sphere (3D) or circle (2D: the trace of a YADE sphere at z = 0); a free DEM sphere is one
+//              part with one circle, a clump of spheres one part with one circle per member
 //   element    segment (2D, trace of a facet at z = 0) or triangle (3D) of a surface mesh; a set of
 //              elements that closes (every edge shared by two triangles / every vertex by two segments)
 //              bounds a volume and gets a signed distance (a closed prism of facets), else it is a thin
@@ -99,6 +101,15 @@ struct PlanePrim {
 };
 
 template <int D>
+struct SpherePrim {
+	using Vec = typename Dim<D>::Vec;
+	int  part;
+	Vec  cL; // centre in the part frame
+	Real r;  // radius [m] (2D: radius of the trace circle)
+	Vec  c;  // world centre (updated)
+};
+
+template <int D>
 struct RigidGroup {
 	using Vec = typename Dim<D>::Vec;
 	using Mat = typename Dim<D>::Mat;
@@ -108,6 +119,8 @@ struct RigidGroup {
 	std::vector<int>         parts; // indices into the contact's part list
 	std::vector<BoxPrim<D>>  boxes;
 	std::vector<PlanePrim<D>> planes;
+	std::vector<SpherePrim<D>> spheres;
+	bool                     enabled = true; // false: skipped entirely this step (a DEM sphere far from the particles)
 	std::vector<Vec>         elemL;    // element vertices in their part's frame, NV per element
 	std::vector<int>         elemPart; // owning part of each element
 	std::vector<Vec>         elem;     // world vertices (updated)
@@ -130,6 +143,10 @@ struct RigidGroup {
 			b.c = q.c + q.R * b.cL;
 			b.R = q.R * b.RL;
 		}
+		for (auto& sp : spheres) {
+			const auto& q = P[sp.part];
+			sp.c = q.c + q.R * sp.cL;
+		}
 		for (auto& pl : planes) {
 			const auto& q = P[pl.part];
 			pl.p = q.c + q.R * pl.pL;
@@ -147,6 +164,16 @@ struct RigidGroup {
 	{
 		Hit h;
 		for (const auto& b : boxes) boxQuery(b, x, h);
+		for (const auto& sp : spheres) {
+			const Vec  r   = x - sp.c;
+			const Real rn  = r.norm();
+			const Real d   = rn - sp.r;
+			if (d < h.d) {
+				h.d = d, h.part = sp.part;
+				if (rn > 0) h.n = r / rn;
+				else h.n = Vec::Unit(0); // at the centre every direction is the nearest
+			}
+		}
 		for (const auto& pl : planes) {
 			Real s = (x - pl.p).dot(pl.n);
 			Real d = pl.twoSided ? std::abs(s) : s;
@@ -166,6 +193,7 @@ struct RigidGroup {
 			Vec e = b.R.cwiseAbs() * b.h; // half extents of the rotated box's AABB
 			grow(b.c - e - Vec::Constant(out), b.c + e + Vec::Constant(out));
 		}
+		for (const auto& sp : spheres) grow(sp.c - Vec::Constant(sp.r + out), sp.c + Vec::Constant(sp.r + out));
 		for (const auto& pl : planes) {
 			int axis = -1;
 			for (int a = 0; a < D; ++a)

@@ -407,6 +407,56 @@ struct SolverWrap {
 		s.contact.part(part).setState(toVec<D>(pos, "rigid body position"), toMat(rot, "rigid body orientation"), toVec<D>(vel, "rigid body velocity"),
 		                              toSpin(angVel, "rigid body angular velocity"));
 	}
+	static void addContactSphere(S& s, int g, int part, bp::object centre, double radius)
+	{
+		s.contact.addSphere(g, part, toVec<D>(centre, "sphere centre"), radius);
+	}
+	// ---- many DEM spheres at once (py/yade_mpm/spheres.py): one call per step, not one per body
+	static std::vector<int> intList(const bp::object& o, const char* name)
+	{
+		np::ndarray a = np::from_object(o, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
+		if (a.get_nd() != 1) throw InputError(std::string(name) + " must be a 1-D integer array");
+		auto* p = reinterpret_cast<int64_t*>(a.get_data());
+		return std::vector<int>(p, p + a.shape(0));
+	}
+	static void setContactGroupsEnabled(S& s, bp::object groups, bool on)
+	{
+		for (int g : intList(groups, "groups")) s.contact.setEnabled(g, on);
+	}
+	// Position, velocity and angular velocity of parts (orientation kept): pos, vel (n, D); angVel (n, 1) in 2D, (n, 3) in 3D.
+	static void setRigidPartMotions(S& s, bp::object parts, bp::object pos, bp::object vel, bp::object angVel)
+	{
+		const auto  ps = intList(parts, "parts");
+		const size_t n = ps.size();
+		constexpr int NS = D == 2 ? 1 : 3;
+		np::ndarray x = asDoubleArray(pos, "positions", D, n), v = asDoubleArray(vel, "velocities", D, n),
+		            w = asDoubleArray(angVel, "angular velocities", NS, n);
+		auto *xp = reinterpret_cast<double*>(x.get_data()), *vp = reinterpret_cast<double*>(v.get_data()), *wp = reinterpret_cast<double*>(w.get_data());
+		for (size_t k = 0; k < n; ++k) {
+			auto& q = s.contact.part(ps[k]);
+			typename Dim<D>::Vec c, u;
+			Spin om;
+			for (int a = 0; a < D; ++a) c[a] = xp[k * D + a], u[a] = vp[k * D + a];
+			for (int a = 0; a < NS; ++a) om[a] = wp[k * NS + a];
+			q.setState(c, q.R, u, om);
+		}
+	}
+	// Reaction forces (n, D) and torques (n, 1 | 3) of parts from the last step.
+	static bp::tuple rigidPartReactions(S& s, bp::object parts)
+	{
+		const auto  ps = intList(parts, "parts");
+		const size_t n = ps.size();
+		constexpr int NS = D == 2 ? 1 : 3;
+		np::ndarray f = np::zeros(bp::make_tuple(n, D), np::dtype::get_builtin<double>());
+		np::ndarray m = np::zeros(bp::make_tuple(n, NS), np::dtype::get_builtin<double>());
+		auto *fp = reinterpret_cast<double*>(f.get_data()), *mp = reinterpret_cast<double*>(m.get_data());
+		for (size_t k = 0; k < n; ++k) {
+			const auto& q = s.contact.part(ps[k]);
+			for (int a = 0; a < D; ++a) fp[k * D + a] = q.force[a];
+			for (int a = 0; a < NS; ++a) mp[k * NS + a] = q.torque[a];
+		}
+		return bp::make_tuple(f, m);
+	}
 	static bp::tuple rigidPartForce(S& s, int part) { return fromVec<D>(s.contact.part(part).force); }
 	static bp::object rigidPartTorque(S& s, int part) { return fromSpin(s.contact.part(part).torque); }
 	// Signed distance, outward normal and owning part of a contact group at a point (for tests and inspection).
@@ -488,6 +538,13 @@ struct SolverWrap {
 		        .def("addContactPlane", &addContactPlane, (bp::arg("group"), bp::arg("part"), bp::arg("point"), bp::arg("normal"), bp::arg("twoSided")))
 		        .def("addContactElement", &addContactElement, (bp::arg("group"), bp::arg("part"), bp::arg("vertices")))
 		        .def("setRigidPartState", &setRigidPartState, (bp::arg("part"), bp::arg("pos"), bp::arg("rot"), bp::arg("vel"), bp::arg("angVel")))
+		        .def("addContactSphere", &addContactSphere, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("radius")),
+		             "sphere (3D) / circle (2D) of radius [m] at centre (part frame) in a contact group")
+		        .def("setContactGroupsEnabled", &setContactGroupsEnabled, (bp::arg("groups"), bp::arg("enabled")),
+		             "switch contact groups on/off (off: skipped entirely)")
+		        .def("setRigidPartMotions", &setRigidPartMotions, (bp::arg("parts"), bp::arg("pos"), bp::arg("vel"), bp::arg("angVel")),
+		             "positions, velocities, angular velocities of many parts (orientation unchanged)")
+		        .def("rigidPartReactions", &rigidPartReactions, bp::arg("parts"), "(forces (n, D), torques (n, 1|3)) of parts")
 		        .def("rigidPartForce", &rigidPartForce, bp::arg("part"))
 		        .def("rigidPartTorque", &rigidPartTorque, bp::arg("part"))
 		        .def("contactQuery", &contactQuery, (bp::arg("group"), bp::arg("point")))

@@ -18,11 +18,12 @@ from .scene import (make_solver, add_region, views, get, id_order, set_initial_s
 from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
 from .bodies import RigidBodies, CONTACT_DEFAULTS
+from .spheres import DemSpheres
 from .progress import Progress
 from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene builders, run loop, result files)
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
            "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
-           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "CONTACT_DEFAULTS",
+           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "CONTACT_DEFAULTS", "DemSpheres",
            "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D"]

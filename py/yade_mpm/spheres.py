@@ -1,0 +1,230 @@
+"""DEM spheres and clumps of spheres touching MPM particles, two-way, through the same PTS contact law
+as the rigid bodies of ``bodies.py`` (paper Sec. 2.3, Eqs. 23–26; pkg-mpm/PtsContact.hpp):
+
+    sp = ym.DemSpheres(solver, mu=0.3)                 # every free sphere and sphere clump in O.bodies
+    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
+                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                                 [Law2_ScGeom_FrictPhys_CundallStrack()]),     # sphere–sphere, YADE's own
+                 ym.MpmEngine(solver, bodies=sp).runner(),                     # sphere–MPM, both ways
+                 NewtonIntegrator(gravity=(0, -9.81, 0))]
+
+Each body is one rigid part of the contact core with its own contact group: a sphere gives one
+circle (2D) / sphere (3D), a clump one per member, in the clump's frame. The contact reaction (force
+and its moment about the body's centre) goes to ``O.forces`` after the MPM step, the opposite force to
+the MPM grid nodes, so NewtonIntegrator moves the spheres; sphere–sphere contacts stay with YADE's
+collider and interaction loop.
+
+Broad phase (far spheres cost almost nothing): a body is *active* (its group enabled, its state sent
+to the solver, its reaction read back) only while its bounding circle/sphere comes within ``reach``
+(2 grid cells: detection distance + stencil) of the axis-aligned box of the MPM particles. Inactive
+bodies are not looked at every step: all positions and velocities are gathered once per check, and
+the next check comes after the time the fastest inactive body (plus the fastest MPM particle) needs,
+at its current speed and with the gravity acceleration of NewtonIntegrator, to cover half of the
+smallest gap — at most ``max_check_steps`` steps later. Between checks a step costs one disabled-flag
+test per far body in C++ and nothing in Python.
+
+2D (plane strain): a sphere acts through its trace at z = 0, the circle of radius √(R² − z_c²); the MPM
+forces are per metre of thickness, and the force/torque added to ``O.forces`` is that × the body's
+thickness t (default: its z-extent, 2R for a sphere at z = 0; or ``thickness``), the convention of
+``bodies.py``: a sphere of YADE mass m moves like a disc of m/t per metre. 2D spheres must stay in the
+plane (``blockedDOFs = 'zXY'``); the trace is taken at registration.
+
+Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation).
+"""
+import math
+
+import numpy as np
+
+from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec
+from .scene import dim_of
+
+
+class DemSpheres:
+    """YADE spheres / sphere clumps in two-way PTS contact with one solver's particles (module doc)."""
+
+    def __init__(self, solver, ids=None, mu=CONTACT_DEFAULTS["mu"], cohesion=CONTACT_DEFAULTS["cohesion"],
+                 chi=CONTACT_DEFAULTS["chi"], d0=CONTACT_DEFAULTS["d0"], thickness=None, max_check_steps=200):
+        """ids: YADE ids of spheres and clumps (None: every sphere that is not a clump member and every
+        clump of spheres in O.bodies); mu [-], cohesion [Pa], chi [-], d0 [m] or None, thickness [m] or
+        None (2D: the body's z-extent); max_check_steps: longest interval between broad-phase checks."""
+        from yade import O
+        _check_params(mu, cohesion, chi, d0, thickness)
+        if int(max_check_steps) != max_check_steps or max_check_steps < 1:
+            raise ValueError(f"max_check_steps = {max_check_steps!r} must be an integer ≥ 1")
+        self.solver, self.dim = solver, dim_of(solver)
+        if ids is None:
+            ids = [b.id for b in O.bodies if b is not None and not b.isClumpMember and self._kind(b) is not None]
+        ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
+        if not ids:
+            raise ValueError("ids: no sphere or clump of spheres to register")
+        s, d = solver, self.dim
+        rows = []
+        for i in ids:
+            if not isinstance(i, (int, np.integer)) or i < 0 or i >= len(O.bodies) or O.bodies[int(i)] is None:
+                raise ValueError(f"body id {i!r} does not exist in O.bodies")
+            b = O.bodies[int(i)]
+            if b.isClumpMember:
+                raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
+            kind = self._kind(b)
+            if kind is None:
+                raise ValueError(f"body id {i} has shape {type(b.shape).__name__}; DemSpheres takes spheres and clumps of "
+                                 "spheres (use yade_mpm.RigidBodies for boxes, walls, facets)")
+            rows.append((b, self._members(b, kind)))
+        self.ids = np.array([b.id for b, _ in rows], dtype=np.int64)
+        if len(set(self.ids.tolist())) != len(self.ids):
+            raise ValueError("ids: a body is listed twice")
+        n = len(rows)
+        self.parts = np.empty(n, np.int64)
+        self.groups = np.empty(n, np.int64)
+        self.bound = np.empty(n)        # bounding radius about the body's centre [m]
+        self.thick = np.empty(n)        # 2D thickness t [m] (1 in 3D)
+        self.is_clump = np.zeros(n, bool)
+        for k, (b, (members, zext, brad)) in enumerate(rows):
+            part = s.addRigidPart()
+            g = s.addContactGroup([part], float(mu), float(cohesion), float(chi), None if d0 is None else float(d0))
+            for cL, r in members:
+                s.addContactSphere(g, part, tuple(cL[:d]), float(r))
+            self.parts[k], self.groups[k], self.bound[k] = part, g, brad
+            self.thick[k] = 1.0 if d == 3 else (thickness if thickness is not None else zext)
+            self.is_clump[k] = type(b.shape).__name__ == "Clump"
+        s.setContactGroupsEnabled(self.groups, False)
+        self.active = np.zeros(n, bool)
+        self.max_check_steps = int(max_check_steps)
+        self._next_check = 0            # solver step of the next broad-phase check
+        self.checks = 0                 # broad-phase checks made (for the benchmark)
+        self._newton = None
+
+    # ------------------------------------------------------------------ set-up helpers
+    @staticmethod
+    def _kind(b):
+        name = type(b.shape).__name__
+        if name == "Sphere":
+            return "sphere"
+        if name == "Clump":
+            from yade import O
+            if all(type(O.bodies[m].shape).__name__ == "Sphere" for m in b.shape.members):
+                return "clump"
+        return None
+
+    def _members(self, b, kind):
+        """[(centre in the body frame (3,), contact radius)], z-extent, bounding radius; 2D: traces at z = 0."""
+        from yade import O
+        c0 = _vec(b.state.pos)
+        if kind == "sphere":
+            spheres = [(np.zeros(3), c0[2], float(b.shape.radius))]
+        else:
+            R0 = _rot(b.state.ori)
+            if self.dim == 2 and not (abs(R0[0, 2]) < 1e-9 and abs(R0[1, 2]) < 1e-9):
+                raise ValueError(f"body id {b.id}: clump rotated out of the x–y plane (2D allows rotation about z only)")
+            spheres = []
+            for mid in b.shape.members:
+                m = O.bodies[mid]
+                cm = _vec(m.state.pos)
+                spheres.append((R0.T @ (cm - c0), cm[2], float(m.shape.radius)))
+        out, zlo, zhi, brad = [], [], [], 0.0
+        for cL, z, r in spheres:
+            zlo.append(z - r), zhi.append(z + r)
+            if self.dim == 2:
+                if abs(z) >= r:
+                    continue                                  # this member does not cross z = 0
+                r = math.sqrt(r * r - z * z)                  # trace circle
+            out.append((cL, r))
+            brad = max(brad, float(np.linalg.norm(cL[:self.dim])) + r)
+        if not out:
+            raise ValueError(f"body id {b.id} does not cross the plane z = 0 of the 2D scene")
+        return out, max(zhi) - min(zlo), brad
+
+    # ------------------------------------------------------------------ every step
+    def _gravity(self):
+        from yade import O
+        if self._newton is None:
+            self._newton = next((e for e in O.engines if type(e).__name__ == "NewtonIntegrator"), False)
+        return float(np.linalg.norm(_vec(self._newton.gravity))) if self._newton else 0.0
+
+    def _broad_phase(self):
+        from yade import O
+        s, d = self.solver, self.dim
+        st = [O.bodies[int(i)].state for i in self.ids]
+        x = np.array([[q.pos[a] for a in range(d)] for q in st])
+        v = np.array([[q.vel[a] for a in range(d)] for q in st])
+        lo = np.array([s.view(f"x{a}").min() for a in range(d)])
+        hi = np.array([s.view(f"x{a}").max() for a in range(d)])
+        reach = 2.0 * s.spacing
+        gap = np.linalg.norm(np.maximum(0.0, np.maximum(lo - x, x - hi)), axis=1) - self.bound - reach
+        act = gap <= 0
+        on, off = self.groups[act & ~self.active], self.groups[~act & self.active]
+        if len(on):
+            s.setContactGroupsEnabled(on, True)
+        if len(off):
+            s.setContactGroupsEnabled(off, False)
+        self.active = act
+        self.checks += 1
+        dt = max(O.dt, 1e-300)
+        if act.all():
+            self._next_check = s.steps + self.max_check_steps
+            return
+        g = gap[~act]
+        vmax = float(np.max(np.linalg.norm(v[~act], axis=1))) + s.maxSpeed
+        acc = self._gravity()
+        half = 0.5 * float(g.min())
+        # time T to cover half the smallest gap: vmax T + ½ acc T² = half
+        T = half / vmax if acc == 0 else (-vmax + math.sqrt(vmax * vmax + 2 * acc * half)) / acc
+        k = int(T / dt) if vmax > 0 or acc > 0 else self.max_check_steps
+        self._next_check = s.steps + max(1, min(self.max_check_steps, k))
+
+    def read(self):
+        """Before the MPM step: broad phase when due, then the kinematics of the active bodies."""
+        from yade import O
+        s, d = self.solver, self.dim
+        if s.steps >= self._next_check:
+            self._broad_phase()
+        k = np.nonzero(self.active)[0]
+        if not len(k):
+            return
+        for j in k[self.is_clump[k]]:                           # orientation matters for clumps only
+            q = O.bodies[int(self.ids[j])].state
+            R = _rot(q.ori)
+            if d == 2:
+                s.setRigidPartState(int(self.parts[j]), (q.pos[0], q.pos[1]), R[:2, :2], (q.vel[0], q.vel[1]), q.angVel[2])
+            else:
+                s.setRigidPartState(int(self.parts[j]), tuple(q.pos), R, tuple(q.vel), tuple(q.angVel))
+        st = [O.bodies[int(i)].state for i in self.ids[k]]
+        x = np.array([[q.pos[a] for a in range(d)] for q in st])
+        v = np.array([[q.vel[a] for a in range(d)] for q in st])
+        w = np.array([[q.angVel[2]] for q in st]) if d == 2 else np.array([[q.angVel[a] for a in range(3)] for q in st])
+        s.setRigidPartMotions(self.parts[k], x, v, w)
+
+    def write(self):
+        """After the MPM step: reactions of the active bodies into O.forces (2D: × thickness)."""
+        from yade import O
+        from yade import Vector3
+        k = np.nonzero(self.active)[0]
+        if not len(k):
+            return
+        f, m = self.solver.rigidPartReactions(self.parts[k])
+        for j, fj, mj in zip(k, f, m):
+            bid, t = int(self.ids[j]), self.thick[j]
+            if self.dim == 2:
+                if fj[0] == 0 and fj[1] == 0 and mj[0] == 0:
+                    continue
+                O.forces.addF(bid, Vector3(fj[0] * t, fj[1] * t, 0.0))
+                O.forces.addT(bid, Vector3(0.0, 0.0, mj[0] * t))
+            else:
+                O.forces.addF(bid, Vector3(*fj))
+                O.forces.addT(bid, Vector3(*mj))
+
+    # ------------------------------------------------------------------ results
+    def _index(self, bid):
+        k = np.nonzero(self.ids == int(bid))[0]
+        if not len(k):
+            raise ValueError(f"body id {bid!r} is not registered; registered: {self.ids.tolist()[:20]}…")
+        return int(k[0])
+
+    def force(self, bid):
+        """Reaction on body `bid` from the last MPM step [N] (2D: per metre of thickness [N/m])."""
+        f, _ = self.solver.rigidPartReactions([int(self.parts[self._index(bid)])])
+        return f[0]
+
+    def thickness(self, bid):
+        """The 2D thickness t [m] that scales the per-metre reaction into O.forces."""
+        return float(self.thick[self._index(bid)])
