@@ -79,6 +79,7 @@ class DemSpheres:
         self.bound = np.empty(n)        # bounding radius about the body's centre [m]
         self.thick = np.empty(n)        # 2D thickness t [m] (1 in 3D)
         self.is_clump = np.zeros(n, bool)
+        self._R0 = {}                   # clump index -> orientation at registration
         for k, (b, (members, zext, brad)) in enumerate(rows):
             part = s.addRigidPart()
             g = s.addContactGroup([part], float(mu), float(cohesion), float(chi), None if d0 is None else float(d0))
@@ -87,6 +88,8 @@ class DemSpheres:
             self.parts[k], self.groups[k], self.bound[k] = part, g, brad
             self.thick[k] = 1.0 if d == 3 else (thickness if thickness is not None else zext)
             self.is_clump[k] = type(b.shape).__name__ == "Clump"
+            if self.is_clump[k]:
+                self._R0[k] = _rot(b.state.ori)
         s.setContactGroupsEnabled(self.groups, False)
         self.active = np.zeros(n, bool)
         self.max_check_steps = int(max_check_steps)
@@ -113,14 +116,13 @@ class DemSpheres:
         if kind == "sphere":
             spheres = [(np.zeros(3), c0[2], float(b.shape.radius))]
         else:
-            R0 = _rot(b.state.ori)
-            if self.dim == 2 and not (abs(R0[0, 2]) < 1e-9 and abs(R0[1, 2]) < 1e-9):
-                raise ValueError(f"body id {b.id}: clump rotated out of the x–y plane (2D allows rotation about z only)")
+            # part frame = world axes at registration (YADE's clump frame is its principal axes, which
+            # may put a member offset along the local z); later poses: R(t) R(registration)ᵀ
             spheres = []
             for mid in b.shape.members:
                 m = O.bodies[mid]
                 cm = _vec(m.state.pos)
-                spheres.append((R0.T @ (cm - c0), cm[2], float(m.shape.radius)))
+                spheres.append((cm - c0, cm[2], float(m.shape.radius)))
         out, zlo, zhi, brad = [], [], [], 0.0
         for cL, z, r in spheres:
             zlo.append(z - r), zhi.append(z + r)
@@ -168,8 +170,11 @@ class DemSpheres:
         acc = self._gravity()
         half = 0.5 * float(g.min())
         # time T to cover half the smallest gap: vmax T + ½ acc T² = half
-        T = half / vmax if acc == 0 else (-vmax + math.sqrt(vmax * vmax + 2 * acc * half)) / acc
-        k = int(T / dt) if vmax > 0 or acc > 0 else self.max_check_steps
+        if acc > 0:
+            T = (-vmax + math.sqrt(vmax * vmax + 2 * acc * half)) / acc
+        else:
+            T = half / vmax if vmax > 0 else math.inf
+        k = int(min(T / dt, self.max_check_steps))
         self._next_check = s.steps + max(1, min(self.max_check_steps, k))
 
     def read(self):
@@ -183,8 +188,11 @@ class DemSpheres:
             return
         for j in k[self.is_clump[k]]:                           # orientation matters for clumps only
             q = O.bodies[int(self.ids[j])].state
-            R = _rot(q.ori)
+            R = _rot(q.ori) @ self._R0[j].T
             if d == 2:
+                if not (abs(R[0, 2]) < 1e-9 and abs(R[1, 2]) < 1e-9):
+                    raise ValueError(f"body id {self.ids[j]}: clump rotated out of the x–y plane (2D: rotation about z only; "
+                                     "block it with blockedDOFs = 'zXY')")
                 s.setRigidPartState(int(self.parts[j]), (q.pos[0], q.pos[1]), R[:2, :2], (q.vel[0], q.vel[1]), q.angVel[2])
             else:
                 s.setRigidPartState(int(self.parts[j]), tuple(q.pos), R, tuple(q.vel), tuple(q.angVel))
