@@ -195,8 +195,65 @@ def run_hook_probe(name, steps, warmup):
     return dict(particles=a.numParticles, yade_step_s=min(ty), direct_step_s=min(td), hook_cost_s=min(ty) - min(td))
 
 
+# The spheres case (issue 12): the dpgk2d_80k scene through O.run, without and with 10⁴ DEM spheres
+# away from the MPM block, registered with yade_mpm.DemSpheres (two-way PTS contact, broad phase).
+SPHERES = dict(base="dpgk2d_80k", n=10_000, radius=0.01, steps=200, quick_steps=60, warmup=10, blocks=3)
+
+
+def run_spheres(name, steps, warmup):
+    """Child process: two YADE scenes in this one process (O.switchScene), the same MPM block in each;
+    scene B also holds SPHERES['n'] spheres resting in one row on a floor wall 1 m beside the block
+    (YADE's collider, sphere–wall contacts and NewtonIntegrator run for them; all registered for MPM
+    contact). Interleaved timed blocks; returns the wall seconds per block of each scene."""
+    import numpy as np
+    import yade_mpm as ym
+    from yade import O, utils
+    from yade.wrapper import (ForceResetter, FrictMat, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Wall_Aabb,
+                              InteractionLoop, Ig2_Sphere_Sphere_ScGeom, Ig2_Wall_Sphere_ScGeom,
+                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
+    dim, material, cells, _, _ = CASES[SPHERES["base"]]
+    r, n = SPHERES["radius"], SPHERES["n"]
+
+    def engines(s, label, bodies):
+        dem = [InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+               InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                               [Law2_ScGeom_FrictPhys_CundallStrack()])] if bodies else []
+        return [ForceResetter()] + dem + [ym.MpmEngine(s, label=label, bodies=bodies).runner(),
+                                          NewtonIntegrator(gravity=(0, -9.81, 0), damping=0.3)]
+    a = build_scene(dim, material, cells)
+    O.engines = engines(a, "mpmNoSpheres", None)
+    O.dt = 1.0
+    O.run(warmup, True)
+    O.switchScene()
+    b = build_scene(dim, material, cells)
+    x0 = cells[0] * SPACING + 1.0
+    mat = O.materials.append(FrictMat(young=1e8, density=2500.0, frictionAngle=0.5))
+    O.bodies.append(utils.wall(0.0, axis=1, material=mat))
+    for k in range(n):   # one row of spheres touching the floor, 0.5 r apart
+        sp = utils.sphere((x0 + 2.5 * r * k, r, 0.0), r, material=mat)
+        sp.state.blockedDOFs = "zXY"
+        O.bodies.append(sp)
+    bodies = ym.DemSpheres(b)
+    O.engines = engines(b, "mpmWithSpheres", bodies)
+    O.dt = 1.0
+    O.run(warmup, True)
+    assert a.lastDt == b.lastDt, "both scenes must step with the MPM stable Δt"
+    O.switchScene()
+    ta, tb = [], []
+    for _ in range(SPHERES["blocks"]):
+        for times in (ta, tb):
+            t0 = time.perf_counter()
+            O.run(steps, True)
+            times.append(time.perf_counter() - t0)
+            O.switchScene()
+    O.switchScene()
+    return dict(particles=a.numParticles, spheres=n, steps=steps, wall_without=ta, wall_with=tb,
+                active_spheres=int(bodies.active.sum()), broad_phase_checks=bodies.checks, coupling_python_wall=bodies.wall,
+                steps_with=b.steps, dt=b.lastDt, threads=ym.getThreads())
+
+
 def child(args):
-    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe}.get(args.mode, run_direct)
+    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe, "spheres": run_spheres}.get(args.mode, run_direct)
     res = fn(args.case, args.steps, args.warmup)
     print("BENCH " + json.dumps(res), flush=True)
 
@@ -284,6 +341,8 @@ def main():
                     help="OMP_WAIT_POLICY for the runs (default inherit: what a user gets, i.e. yade_mpm's short "
                          "GOMP_SPINCOUNT then sleep; passive sleeps at once, which suits a host whose cores are "
                          "shared with other jobs; active spins, best on an idle host)")
+    ap.add_argument("--spheres", action="store_true", help="also the spheres case: MPM particle-steps/s with 10⁴ DEM spheres "
+                    "away from the block / without them (one process, interleaved)")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--mode", default="direct", help=argparse.SUPPRESS)
     ap.add_argument("--case", help=argparse.SUPPRESS)
@@ -324,7 +383,7 @@ def main():
         print(f"[bench {k + 1}/{len(jobs)}, {time.time() - t_start:.0f} s] {c} {t}T: {r['particle_steps_per_s'] / 1e6:.2f} M p-steps/s, "
               f"{r['ns_per_particle_step']:.0f} ns/p-step", flush=True)
     hooks = []
-    if not args.no_hook:
+    if not args.no_hook and cases:
         c = "dpgk2d_80k" if "dpgk2d_80k" in cases else cases[0]
         _, _, _, steps, warm = CASES[c]
         if args.quick:
@@ -349,6 +408,24 @@ def main():
         hooks.append(dict(case="hook fixed cost per step", probe=pr))
         print(f"[bench] YADE hook fixed cost {pr['hook_cost_s'] * 1e6:.0f} µs per step "
               f"({', '.join(f'{100 * v:.2f} % of a {c} step with {t}T' for t, v in pr['fraction_of_step'].items())})", flush=True)
+    spheres = []
+    if args.spheres:
+        for t in threads:
+            steps = SPHERES["quick_steps"] if args.quick else SPHERES["steps"]
+            r = spawn("spheres", "spheres", t, steps, SPHERES["warmup"])
+            wa, wb = statistics.median(r["wall_without"]), statistics.median(r["wall_with"])
+            row = dict(case=f"{SPHERES['base']} + {r['spheres']} spheres", threads=t, particles=r["particles"], spheres=r["spheres"],
+                       rate_without=r["particles"] * steps / wa, rate_with=r["particles"] * steps / wb, ratio=wa / wb,
+                       wall_without=r["wall_without"], wall_with=r["wall_with"], active_spheres=r["active_spheres"],
+                       broad_phase_checks=r["broad_phase_checks"], steps_with=r["steps_with"],
+                       coupling_python_s_per_step=r["coupling_python_wall"] / r["steps_with"],
+                       step_s_with=wb / steps)
+            spheres.append(row)
+            print(f"[bench] spheres {t}T: {row['rate_with'] / 1e6:.2f} M p-steps/s with {r['spheres']} DEM spheres vs "
+                  f"{row['rate_without'] / 1e6:.2f} M without → ratio {row['ratio']:.3f} ({row['active_spheres']} active, "
+                  f"{row['broad_phase_checks']} broad-phase checks in {row['steps_with']} steps; Python side of the coupling "
+                  f"{1e6 * row['coupling_python_s_per_step']:.0f} µs per step = "
+                  f"{100 * row['coupling_python_s_per_step'] / row['step_s_with']:.1f} % of a step)", flush=True)
     paper = []
     if args.paper:
         for name, cfg in PAPER.items():
@@ -365,7 +442,7 @@ def main():
                                   plastic_fraction=r.get("plastic_fraction"), damaged_fraction=r.get("damaged_fraction")))
                 print(f"[bench] {name} ({r['particles']:,} particles, {t}T, C = {courant}): {rate / 1e6:.2f} M p-steps/s, "
                       f"{n:,.0f} steps → {n * r['particles'] / rate / 60:.1f} min (extrapolated)", flush=True)
-    summary = dict(cases=rows, hook=hooks, paper=paper, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
+    summary = dict(cases=rows, hook=hooks, paper=paper, spheres=spheres, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
                    gomp_spincount=os.environ.get("GOMP_SPINCOUNT", "10000 (yade_mpm default)"),
                    load_average_before=load_before, load_average_after=os.getloadavg(),

@@ -32,6 +32,7 @@ plane (``blockedDOFs = 'zXY'``); the trace is taken at registration.
 Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation).
 """
 import math
+import time
 
 import numpy as np
 
@@ -95,6 +96,7 @@ class DemSpheres:
         self.max_check_steps = int(max_check_steps)
         self._next_check = 0            # solver step of the next broad-phase check
         self.checks = 0                 # broad-phase checks made (for the benchmark)
+        self.wall = 0.0                 # wall seconds spent in read() and write() (Python side of the coupling)
         self._newton = None
 
     # ------------------------------------------------------------------ set-up helpers
@@ -179,6 +181,13 @@ class DemSpheres:
 
     def read(self):
         """Before the MPM step: broad phase when due, then the kinematics of the active bodies."""
+        t0 = time.perf_counter()
+        try:
+            self._read()
+        finally:
+            self.wall += time.perf_counter() - t0
+
+    def _read(self):
         from yade import O
         s, d = self.solver, self.dim
         if s.steps >= self._next_check:
@@ -204,6 +213,13 @@ class DemSpheres:
 
     def write(self):
         """After the MPM step: reactions of the active bodies into O.forces (2D: × thickness)."""
+        t0 = time.perf_counter()
+        try:
+            self._write()
+        finally:
+            self.wall += time.perf_counter() - t0
+
+    def _write(self):
         from yade import O
         from yade import Vector3
         k = np.nonzero(self.active)[0]
