@@ -65,6 +65,7 @@ def parse_args(argv=None):
     p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (table: 2l, 1.5l, l)")
     p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
                    help="JCFpm mean radii [m] of the Kirsch runs")
+    p.add_argument("--reuse-mpm", action="store_true", help="reuse the MPM uniaxial runs saved in OUT (mpm_*.npz)")
     p.add_argument("--cache", default=None, help="directory for cached disc packings (default: OUT/packings)")
     a = p.parse_args(argv)
     parts = set(a.parts.split(","))
@@ -90,10 +91,63 @@ def log(msg):
 
 
 # ---------------------------------------------------------------------------------------------- MPM
+SPECIMEN = (0.05, 0.15)                     # width × height [m] (paper Sec. 3.3)
+FLAW = dict(center=(0.025, 0.075), length=0.025, width=0.002, angle=math.radians(30.0))
+DAMPING = 0.4                               # local (Cundall) damping on both sides: MPM solver.damping, YADE Newton
+
+
+def uniaxial_flaw():
+    return ym.rotated_rectangle(FLAW["center"], FLAW["length"], FLAW["width"], FLAW["angle"])
+
+
+def mpm_uniaxial_saved(flaw, a):
+    """mpm_uniaxial, saved to OUT/mpm_<case>.npz (reused with --reuse-mpm when the spacing and speed match)."""
+    path = os.path.join(a.out, f"mpm_{'open_flaw' if flaw else 'intact'}.npz")
+    if a.reuse_mpm and os.path.exists(path):
+        z = dict(np.load(path))
+        if float(z["spacing"]) == a.mpm_spacing and float(z["speed"]) == a.platen_speed:
+            log(f"reusing {path}")
+            return {k: (v.item() if v.ndim == 0 else v) for k, v in z.items()}
+    r = mpm_uniaxial(flaw, a)
+    np.savez(path, spacing=a.mpm_spacing, speed=a.platen_speed, **r)
+    return r
+
+
 def mpm_uniaxial(flaw, a):
-    """MPM uniaxial run (cases uniaxial builder): dict(strain, stress [Pa] compression +, particles,
-    wall_time_s, pos, damage, plastic_strain)."""
-    raise NotImplementedError("waiting for the uniaxial builder of helper 'contact'")
+    """MPM uniaxial run: the specimen between two frictionless YADE walls (PTS contact, RigidBodies), the
+    top one moving down at platen_speed; DP–GK sandstone, ppc = 2, local damping DAMPING. Returns
+    dict(strain, stress [Pa] compression +, particles, wall_time_s, pos, damage)."""
+    from yade import O, utils
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+    O.reset()
+    W, H = SPECIMEN
+    l = a.mpm_spacing
+    s = ym.make_solver((0.0, 0.0), (W, H), l, margin=3)
+    ym.add_region(s, rocks.miao2018_sandstone(), (0.0, 0.0), (W, H), ppc=2, holes=[uniaxial_flaw()] if flaw else [])
+    s.damping = DAMPING
+    bot = O.bodies.append(utils.wall(0.0, axis=1, sense=1))
+    top = O.bodies.append(utils.wall(H, axis=1, sense=-1))
+    rb = ym.RigidBodies(s)
+    rb.add([bot, top], mu=0.0)
+    O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmUniax", bodies=rb).runner(), NewtonIntegrator(damping=0.0)]
+    O.dt = 1.0
+    O.bodies[top].state.vel = (0.0, -a.platen_speed, 0.0)
+    label = "mpm " + ("open flaw" if flaw else "intact")
+    prog = ym.Progress(a.max_strain, label, 20.0)
+    strain, stress, peak = [0.0], [0.0], 0.0
+    t0 = time.time()
+    while True:
+        O.run(100, True)
+        strain.append((H - (O.bodies[top].state.pos[1] - O.bodies[bot].state.pos[1])) / H)
+        stress.append(0.5 * (rb.force(top)[1] - rb.force(bot)[1]) / W)
+        peak = max(peak, stress[-1])
+        prog.update(0, strain[-1])
+        if strain[-1] >= a.max_strain or (stress[-1] < 0.7 * peak and stress[-1] < stress[-2]):
+            break
+    wall = time.time() - t0
+    o = ym.id_order(s)
+    return dict(strain=np.array(strain), stress=np.array(stress), particles=int(s.numParticles), wall_time_s=wall,
+                pos=ym.get(s, "pos", o), damage=ym.get(s, "damage", o), steps=int(s.steps), dt=float(s.lastDt))
 
 
 # ------------------------------------------------------------------------------------------- JCFpm
@@ -106,7 +160,7 @@ def packing(a, lo, hi, r):
 
 def jcfpm_uniaxial(P, micro, holes, a, label):
     prog = ym.Progress(a.max_strain, label, 20.0)
-    res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.max_strain,
+    res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.max_strain, damping=DAMPING,
                           crack_dir=os.path.join(a.out, "jcfpm_cracks"), label=label,
                           progress=lambda e, s: prog.update(0, e))
     res["youngs_modulus"] = bonded.apparent_modulus(res["strain"], res["stress"])
@@ -204,11 +258,11 @@ def plot_cracks(path, mpm, dem, holes, title):
 
 # ------------------------------------------------------------------------------------------- parts
 def uniaxial_part(a, summary):
-    lo, hi = (0.0, 0.0), (cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT)
+    lo, hi = (0.0, 0.0), SPECIMEN
     P, t_pack = packing(a, lo, hi, a.dem_radius)
     log(f"disc packing: {len(P)} spheres, r̄ = {a.dem_radius * 1e3} mm ({t_pack:.1f} s)")
     results = {}
-    mpm_int = mpm_uniaxial(False, a)
+    mpm_int = mpm_uniaxial_saved(False, a)
     mpm_int["youngs_modulus"] = bonded.apparent_modulus(mpm_int["strain"], mpm_int["stress"])
     mpm_int["peak_stress"] = float(np.max(mpm_int["stress"]))
     log(f"MPM intact: E = {mpm_int['youngs_modulus'] / GPa:.3f} GPa, peak = {mpm_int['peak_stress'] / MPa:.2f} MPa, "
@@ -219,8 +273,8 @@ def uniaxial_part(a, summary):
         w.writeheader()
         w.writerows(rows)
     results["intact"] = dict(mpm=mpm_int, jcfpm=dem_int)
-    holes = [cases.uniaxial_flaw()]
-    mpm_fl = mpm_uniaxial(True, a)
+    holes = [uniaxial_flaw()]
+    mpm_fl = mpm_uniaxial_saved(True, a)
     mpm_fl["youngs_modulus"] = bonded.apparent_modulus(mpm_fl["strain"], mpm_fl["stress"])
     mpm_fl["peak_stress"] = float(np.max(mpm_fl["stress"]))
     dem_fl = jcfpm_uniaxial(P, micro, holes, a, "open_flaw")
