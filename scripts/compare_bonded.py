@@ -54,13 +54,15 @@ PILOT_E_RATIO, PILOT_PEAK_RATIO = 0.51, 3.9
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--parts", default="uniaxial,kirsch", help="comma list of: uniaxial, kirsch")
-    p.add_argument("--platen-speed", type=float, default=0.5, help="platen closing speed [m/s] (both methods)")
+    p.add_argument("--parts", default="uniaxial,kirsch",
+                   help="comma list of: uniaxial, kirsch, mpm_intact, mpm_open_flaw (the last two only run and save one MPM "
+                        "uniaxial test, for running them in parallel before 'uniaxial --reuse-mpm')")
+    p.add_argument("--platen-speed", type=float, default=1.0, help="platen closing speed [m/s] (both methods)")
     p.add_argument("--mpm-spacing", type=float, default=1e-3, help="MPM grid spacing [m] (flaw width 2 mm ≥ 2 cells)")
     p.add_argument("--dem-radius", type=float, default=0.75e-3, help="JCFpm mean sphere radius [m]")
     p.add_argument("--calib-tol", type=float, default=0.05, help="calibration stops when E and peak are within this")
     p.add_argument("--calib-iters", type=int, default=4, help="maximum calibration runs")
-    p.add_argument("--max-strain", type=float, default=0.012, help="axial strain limit of a uniaxial run")
+    p.add_argument("--max-strain", type=float, default=0.03, help="axial strain limit of a uniaxial run")
     p.add_argument("--kirsch-domain", type=float, default=1.2, help="side of the square block of the Kirsch test [m]")
     p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (table: 2l, 1.5l, l)")
     p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
@@ -69,8 +71,8 @@ def parse_args(argv=None):
     p.add_argument("--cache", default=None, help="directory for cached disc packings (default: OUT/packings)")
     a = p.parse_args(argv)
     parts = set(a.parts.split(","))
-    if not parts <= {"uniaxial", "kirsch"}:
-        raise ValueError(f"--parts = {a.parts}: allowed uniaxial, kirsch")
+    if not parts <= {"uniaxial", "kirsch", "mpm_intact", "mpm_open_flaw"}:
+        raise ValueError(f"--parts = {a.parts}: allowed uniaxial, kirsch, mpm_intact, mpm_open_flaw")
     for n in ("platen_speed", "mpm_spacing", "dem_radius", "calib_tol", "max_strain", "kirsch_domain", "kirsch_mpm_spacing"):
         v = getattr(a, n)
         if not (math.isfinite(v) and v > 0):
@@ -366,6 +368,9 @@ def main(argv=None):
     path = os.path.join(a.out, "summary.json")
     summary = json.load(open(path)) if os.path.exists(path) else {}
     summary["case"] = "yade-mpm (WLS-MPM, DP-GK) vs YADE JCFpm bonded particles: Sec. 3.3 uniaxial + Sec. 3.1 Kirsch"
+    for case in ("mpm_intact", "mpm_open_flaw"):
+        if case in a.parts:
+            mpm_uniaxial_saved(case == "mpm_open_flaw", a)
     if "kirsch" in a.parts:
         kirsch_part(a, summary)
         out.write_summary(a.out, summary)
