@@ -62,9 +62,11 @@ def parse_args(argv=None):
     p.add_argument("--dem-radius", type=float, default=0.75e-3, help="JCFpm mean sphere radius [m]")
     p.add_argument("--calib-tol", type=float, default=0.05, help="calibration stops when E and peak are within this")
     p.add_argument("--calib-iters", type=int, default=4, help="maximum calibration runs")
+    p.add_argument("--calib-ratios", type=float, nargs=2, default=[PILOT_E_RATIO, PILOT_PEAK_RATIO], metavar=("E_RATIO", "PEAK_RATIO"),
+                   help="initial guess: E_app/young and peak/tensile of an earlier run (default: the pilot run's)")
     p.add_argument("--max-strain", type=float, default=0.03, help="axial strain limit of a uniaxial run")
     p.add_argument("--kirsch-domain", type=float, default=1.2, help="side of the square block of the Kirsch test [m]")
-    p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (table: 2l, 1.5l, l)")
+    p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (runs: 2l, 1.5l, l)")
     p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
                    help="JCFpm mean radii [m] of the Kirsch runs")
     p.add_argument("--reuse-mpm", action="store_true", help="reuse the MPM uniaxial runs saved in OUT (mpm_*.npz)")
@@ -79,6 +81,8 @@ def parse_args(argv=None):
             raise ValueError(f"--{n.replace('_', '-')} = {v} must be > 0")
     if not a.dem_radius < 0.005:
         raise ValueError(f"--dem-radius = {a.dem_radius} m must be < 5 mm (≥ 5 spheres across the 50 mm specimen)")
+    if any(not (math.isfinite(x) and x > 0) for x in a.calib_ratios):
+        raise ValueError(f"--calib-ratios = {a.calib_ratios} must be > 0")
     if a.calib_iters < 1:
         raise ValueError(f"--calib-iters = {a.calib_iters} must be ≥ 1")
     if any(not (0 < r <= 0.05) for r in a.kirsch_dem_radii):
@@ -137,18 +141,18 @@ def mpm_uniaxial(flaw, a):
     label = "mpm " + ("open flaw" if flaw else "intact")
     prog = ym.Progress(a.max_strain, label, 20.0)
     strain, stress, peak = [0.0], [0.0], 0.0
-    t0 = time.time()
+    t0, c0 = time.time(), time.process_time()
     while True:
         O.run(100, True)
         strain.append((H - (O.bodies[top].state.pos[1] - O.bodies[bot].state.pos[1])) / H)
         stress.append(0.5 * (rb.force(top)[1] - rb.force(bot)[1]) / W)
         peak = max(peak, stress[-1])
-        prog.update(0, strain[-1])
+        prog.update(s.steps, strain[-1])
         if strain[-1] >= a.max_strain or (stress[-1] < 0.7 * peak and stress[-1] < stress[-2]):
             break
-    wall = time.time() - t0
+    wall, cpu = time.time() - t0, time.process_time() - c0
     o = ym.id_order(s)
-    return dict(strain=np.array(strain), stress=np.array(stress), particles=int(s.numParticles), wall_time_s=wall,
+    return dict(strain=np.array(strain), stress=np.array(stress), particles=int(s.numParticles), wall_time_s=wall, cpu_time_s=cpu,
                 pos=ym.get(s, "pos", o), damage=ym.get(s, "damage", o), steps=int(s.steps), dt=float(s.lastDt))
 
 
@@ -172,8 +176,9 @@ def jcfpm_uniaxial(P, micro, holes, a, label):
 
 def calibrate(P, target_E, target_peak, a):
     """Fixed-point scaling of (young) and (tensile, cohesion) until E and peak are within calib_tol."""
-    micro = bonded.JcfpmMicro(young=target_E / PILOT_E_RATIO, ks_kn=KS_KN, tensile=target_peak / PILOT_PEAK_RATIO,
-                              cohesion=COH_OVER_TENS * target_peak / PILOT_PEAK_RATIO, friction_deg=FRICTION_DEG)
+    er, pr = a.calib_ratios
+    micro = bonded.JcfpmMicro(young=target_E / er, ks_kn=KS_KN, tensile=target_peak / pr,
+                              cohesion=COH_OVER_TENS * target_peak / pr, friction_deg=FRICTION_DEG)
     rows, res = [], None
     t0 = time.time()
     for it in range(a.calib_iters):
@@ -181,7 +186,7 @@ def calibrate(P, target_E, target_peak, a):
         eE, eP = res["youngs_modulus"] / target_E - 1, res["peak_stress"] / target_peak - 1
         rows.append(dict(iteration=it, **micro.as_dict(), youngs_modulus_GPa=res["youngs_modulus"] / GPa,
                          peak_stress_MPa=res["peak_stress"] / MPa, rel_error_E=eE, rel_error_peak=eP,
-                         wall_time_s=res["wall_time_s"]))
+                         wall_time_s=res["wall_time_s"], cpu_time_s=res["cpu_time_s"]))
         log(f"calibration {it}: young = {micro.young / GPa:.3f} GPa, tensile = {micro.tensile / MPa:.3f} MPa → "
             f"E = {res['youngs_modulus'] / GPa:.3f} GPa ({100 * eE:+.1f} %), peak = {res['peak_stress'] / MPa:.2f} MPa "
             f"({100 * eP:+.1f} %), {res['wall_time_s']:.0f} s")
@@ -202,9 +207,7 @@ def write_curve(path, strain, stress):
 
 
 def plot_curves(path, results):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = out.pyplot()
     fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
     for ax, (case, r) in zip(axes[0], results.items()):
         for meth, style in (("mpm", "k-"), ("jcfpm", "r-")):
@@ -224,9 +227,7 @@ def plot_curves(path, results):
 
 
 def plot_cracks(path, mpm, dem, holes, title):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = out.pyplot()
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle as CircleP, Polygon as PolyP
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(7, 8.5))
@@ -286,7 +287,8 @@ def uniaxial_part(a, summary):
             write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
             summary.setdefault(case, {})[meth] = dict(youngs_modulus_GPa=q["youngs_modulus"] / GPa,
                                                       peak_stress_MPa=q["peak_stress"] / MPa,
-                                                      particles=int(q["particles"]), wall_time_s=q["wall_time_s"])
+                                                      particles=int(q["particles"]), wall_time_s=q["wall_time_s"],
+                                                      cpu_time_s=q["cpu_time_s"], steps=int(q["steps"]))
         keep = np.ones(len(P), bool)
         for h in (holes if case == "open_flaw" else ()):
             keep &= ~bonded.overlapping(h, P[:, :2], P[:, 2])
@@ -296,8 +298,7 @@ def uniaxial_part(a, summary):
                     f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
         for meth in ("jcfpm",):
             q = r[meth]
-            summary[case][meth].update(tensile_cracks=q["tensile_cracks"], shear_cracks=q["shear_cracks"],
-                                       bonds=q["bonds"], steps=q["steps"])
+            summary[case][meth].update(tensile_cracks=q["tensile_cracks"], shear_cracks=q["shear_cracks"], bonds=q["bonds"])
     plot_curves(os.path.join(a.out, "stress_strain.png"), results)
     summary["calibration"] = dict(procedure="fixed-point scaling: young *= E_mpm/E, tensile and cohesion *= peak_mpm/peak; "
                                             f"ks/kn = {KS_KN}, cohesion/tensile = {COH_OVER_TENS}, friction = {FRICTION_DEG:.1f} deg",
@@ -308,54 +309,63 @@ def uniaxial_part(a, summary):
 
 
 def kirsch_part(a, summary):
+    """Both methods on the same block, one thread; run time = CPU seconds of the run (insensitive to other
+    processes on a shared host; equal to the wall time on an idle core), wall seconds kept too."""
+    import resource
     rows = []
-    # MPM: the circular-opening script's own convergence table (error and wall time per spacing)
-    mdir = os.path.join(a.out, "kirsch_mpm")
+    # MPM: scripts/circular_opening.py, one subprocess per spacing (its own errors; CPU time from rusage)
     l = a.kirsch_mpm_spacing
-    cmd = [sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "circular_opening.py"), "--out", mdir,
-           "--domain", str(a.kirsch_domain), "--spacing", str(l), "--no-vtu", "--threads", "1",
-           "--convergence-spacings", str(2 * l), str(1.5 * l), str(l)]
-    log("MPM circular opening: " + " ".join(cmd[1:]))
-    subprocess.run(cmd, check=True)
-    with open(os.path.join(mdir, "summary.json")) as f:
-        ms = json.load(f)
-    for r in ms["convergence"]:
-        rows.append(dict(method="mpm", resolution_m=r["grid_spacing_m"], particles=r["particles"],
-                         wall_time_s=r["wall_time_s"], l2_rel_error_max=r["l2_rel_error_max"]))
+    for sp in (2 * l, 1.5 * l, l):
+        mdir = os.path.join(a.out, f"kirsch_mpm_{sp * 1e3:g}mm")
+        cmd = [sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "circular_opening.py"), "--out", mdir,
+               "--domain", str(a.kirsch_domain), "--spacing", str(sp), "--no-vtu", "--threads", "1", "--no-convergence"]
+        log("MPM circular opening: " + " ".join(cmd[2:]))
+        c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run(cmd, check=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+        c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        with open(os.path.join(mdir, "summary.json")) as f:
+            ms = json.load(f)
+        rows.append(dict(method="mpm", resolution_m=sp, particles=ms["particles"], wall_time_s=ms["wall_time_s"],
+                         cpu_time_s=(c1.ru_utime + c1.ru_stime) - (c0.ru_utime + c0.ru_stime),
+                         l2_rel_error_max=ms["l2_rel_error_max"], l2_rel_error_near_max=ms["l2_rel_error_near_max"]))
     # JCFpm
     c, L = cases.OPENING_CENTER, a.kirsch_domain
     micro = bonded.JcfpmMicro(young=rocks.GRANITE["young"], ks_kn=KS_KN, tensile=1e15, cohesion=1e15, friction_deg=30.0)
-    profiles = {}
     for r in sorted(a.kirsch_dem_radii, reverse=True):
         P, t_pack = packing(a, (c - L / 2, c - L / 2), (c + L / 2, c + L / 2), r)
         res = bonded.circular_opening(P, micro, (c, c), cases.OPENING_RADIUS, cases.OPENING_SXX, cases.OPENING_SYY,
                                       rocks.GRANITE["density"])
         log(f"JCFpm circular opening r̄ = {r} m: {res['particles']} spheres, {res['steps']} steps, "
-            f"{res['wall_time_s']:.1f} s, max L2 error {100 * res['l2_rel_error_max']:.1f} %")
+            f"{res['cpu_time_s']:.1f} s CPU, max L2 error {100 * res['l2_rel_error_max']:.1f} % "
+            f"(2a ≤ r ≤ 5a: {100 * res['l2_rel_error_near_max']:.1f} %)")
         rows.append(dict(method="jcfpm", resolution_m=r, particles=res["particles"], wall_time_s=res["wall_time_s"],
-                         l2_rel_error_max=res["l2_rel_error_max"], packing_wall_time_s=t_pack))
-        profiles[r] = res["profiles"]
+                         cpu_time_s=res["cpu_time_s"], l2_rel_error_max=res["l2_rel_error_max"],
+                         l2_rel_error_near_max=res["l2_rel_error_near_max"], packing_wall_time_s=t_pack))
+    keys = ["method", "resolution_m", "particles", "wall_time_s", "cpu_time_s", "l2_rel_error_max", "l2_rel_error_near_max",
+            "packing_wall_time_s"]
     with open(os.path.join(a.out, "kirsch_error_vs_time.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["method", "resolution_m", "particles", "wall_time_s", "l2_rel_error_max",
-                                          "packing_wall_time_s"])
+        w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         w.writerows(rows)
-    summary["kirsch"] = [dict(method=r["method"], wall_time_s=r["wall_time_s"], l2_rel_error_max=r["l2_rel_error_max"],
-                              particles=r["particles"], resolution_m=r["resolution_m"]) for r in rows]
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 4.3))
-    for meth, st, name in (("mpm", "ko-", "MPM (grid spacing l)"), ("jcfpm", "rs-", "JCFpm (mean radius r̄)")):
+    summary["kirsch"] = [{k: r[k] for k in keys if k in r} for r in rows]
+    summary["kirsch_setup"] = dict(domain_m=L, hole_radius_m=cases.OPENING_RADIUS, far_field_MPa=[cases.OPENING_SXX / MPa,
+                                   cases.OPENING_SYY / MPa], jcfpm_window_radius_m=0.5 * cases.OPENING_RADIUS,
+                                   time="cpu_time_s: CPU seconds of the one-thread run; wall_time_s depends on the host load")
+    plt = out.pyplot()
+    fig, ax = plt.subplots(figsize=(6.2, 4.4))
+    for meth, col, mk, name in (("mpm", "k", "o", "MPM (grid spacing l)"), ("jcfpm", "r", "s", "JCFpm (mean radius r̄)")):
         q = [r for r in rows if r["method"] == meth]
-        ax.loglog([r["wall_time_s"] for r in q], [100 * r["l2_rel_error_max"] for r in q], st, label=name)
+        t = [r["cpu_time_s"] for r in q]
+        ax.loglog(t, [100 * r["l2_rel_error_max"] for r in q], "-", color=col, marker=mk, label=f"{name}: r ≥ 2a")
+        ax.loglog(t, [100 * r["l2_rel_error_near_max"] for r in q], "--", color=col, marker=mk, mfc="none",
+                  label=f"{name}: 2a ≤ r ≤ 5a")
         for r in q:
-            ax.annotate(f"{r['resolution_m'] * 1e3:g} mm, {r['particles']}", (r["wall_time_s"], 100 * r["l2_rel_error_max"]),
+            ax.annotate(f"{r['resolution_m'] * 1e3:g} mm, {r['particles']}", (r["cpu_time_s"], 100 * r["l2_rel_error_max"]),
                         fontsize=7, textcoords="offset points", xytext=(4, 3))
-    ax.set_xlabel("wall time [s] (one thread)")
-    ax.set_ylabel("max relative L2 stress error vs Kirsch [%]")
-    ax.set_title(f"circular opening, {L} m block, a = {cases.OPENING_RADIUS} m", fontsize=9)
-    ax.legend(fontsize=8)
+    ax.set_xlabel("run time [CPU s, one thread]")
+    ax.set_ylabel("max relative L2 error of σxx, σyy vs Kirsch [%]")
+    ax.set_title(f"circular opening: {L} m block, a = {cases.OPENING_RADIUS} m, far field 20/10 MPa", fontsize=9)
+    ax.legend(fontsize=7)
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
     fig.savefig(os.path.join(a.out, "kirsch_error_vs_time.png"), dpi=130)

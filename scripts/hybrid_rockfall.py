@@ -26,7 +26,6 @@ import argparse
 import glob
 import math
 import os
-import sys
 import time
 
 import numpy as np

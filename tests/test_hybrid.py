@@ -2,7 +2,6 @@
 a dropped sphere rebounds, the impulse on the sphere is minus the momentum the MPM particles gained,
 a resting sphere comes to rest under its weight, a clump acts like a sphere, and spheres far from the
 particles are not examined every step and change nothing."""
-import math
 
 import numpy as np
 import pytest
