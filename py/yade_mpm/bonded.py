@@ -152,7 +152,7 @@ def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1
     """Uniaxial compression of a JCFpm disc-layer specimen between two frictionless platens (YADE
     walls; the top one moves down at platen_speed [m/s], the bottom one is fixed), run in O.
     Bonds: every pair closer than idf·(r1 + r2) at the first step (JCFpm convention), then idf = 1.
-    Stops when the stress has dropped below post_peak_drop·peak after the peak, or at max_strain.
+    Stops when the stress has stayed below post_peak_drop·peak for three records, or at max_strain.
     Returns dict(strain, stress [Pa] (compression +), particles, steps, wall_time_s, cpu_time_s, dt, bonds,
     tensile_cracks, shear_cracks, cracks (K, 3): x, y, type (0 tension, 1 shear)).
     crack_dir: where JCFpm writes its cracks_<label>.txt (default: a temporary directory)."""
@@ -222,7 +222,7 @@ def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1
             peak = max(peak, stress[-1])
             if progress:
                 progress(strain[-1], stress[-1])
-            if strain[-1] >= max_strain or (peak > 0 and stress[-1] < post_peak_drop * peak and stress[-1] < stress[-2]):
+            if strain[-1] >= max_strain or (peak > 0 and len(stress) > 3 and max(stress[-3:]) < post_peak_drop * peak):
                 break
         wall, cpu = time.time() - t0, time.process_time() - c0
     finally:
