@@ -70,7 +70,7 @@ def parse_args(argv=None):
     p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
                    help="JCFpm mean radii [m] of the Kirsch runs")
     p.add_argument("--capped-ends", action=argparse.BooleanOptionalAction, default=True,
-                   help="MPM: no tensile damage in the particle rows within one cell of the platens (default on)")
+                   help="MPM: no tensile damage within CAP_CELLS = 3 cells of the platens (default on)")
     p.add_argument("--reuse-mpm", action="store_true", help="reuse the MPM uniaxial runs saved in OUT (mpm_*.npz)")
     p.add_argument("--cache", default=None, help="directory for cached disc packings (default: OUT/packings)")
     a = p.parse_args(argv)
@@ -101,6 +101,7 @@ def log(msg):
 # ---------------------------------------------------------------------------------------------- MPM
 SPECIMEN = (0.05, 0.15)                     # width × height [m] (paper Sec. 3.3)
 FLAW = dict(center=(0.025, 0.075), length=0.025, width=0.002, angle=math.radians(30.0))
+CAP_CELLS = 3                               # MPM end caps: no tensile damage within 3 cells of a platen
 DAMPING = 0.4                               # local (Cundall) damping on both sides: MPM solver.damping, YADE Newton
 
 
@@ -130,14 +131,14 @@ def mpm_uniaxial(flaw, a):
     O.reset()
     W, H = SPECIMEN
     l = a.mpm_spacing
-    s = ym.make_solver((0.0, 0.0), (W, H), l, margin=3)
+    s = ym.make_solver((0.0, 0.0), (W, H), l, margin=8)        # room for fragments pushed out sideways
     ym.add_region(s, rocks.miao2018_sandstone(), (0.0, 0.0), (W, H), ppc=2, holes=[uniaxial_flaw()] if flaw else [])
     s.damping = DAMPING
     if a.capped_ends:
-        # end caps: the particle rows within one cell of each platen get a Grady–Kipp activation strain
-        # that tension never reaches (ε_D⁰ = 0.99, Eq. 37), so the penalty-contact layer does not crack
+        # end caps: the particles within CAP_CELLS cells of each platen get a Grady–Kipp activation strain
+        # that tension never reaches (ε_D⁰ = 0.99, Eq. 37), so the layer under the penalty contact does not crack
         y, e0 = s.view("x1"), s.view("eps0")
-        e0[(y < l) | (y > H - l)] = 0.99
+        e0[(y < CAP_CELLS * l) | (y > H - CAP_CELLS * l)] = 0.99
     bot = O.bodies.append(utils.wall(0.0, axis=1, sense=1))
     top = O.bodies.append(utils.wall(H, axis=1, sense=-1))
     rb = ym.RigidBodies(s)
