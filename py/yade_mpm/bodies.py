@@ -57,6 +57,17 @@ def _check_params(mu, cohesion, chi, d0, thickness):
         bad("thickness", thickness, "(0, inf) [m] or None (the body's z-extent)")
 
 
+def _yade_body(i):
+    """O.bodies[i] for a registrable id: it must exist and not be a clump member (pass the clump)."""
+    from yade import O
+    if not isinstance(i, (int, np.integer)) or i < 0 or i >= len(O.bodies) or O.bodies[int(i)] is None:
+        raise ValueError(f"body id {i!r} does not exist in O.bodies")
+    b = O.bodies[int(i)]
+    if b.isClumpMember:
+        raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
+    return b
+
+
 def _rot(q):
     m = q.toRotationMatrix()
     return np.array([[m[i, j] for j in range(3)] for i in range(3)])
@@ -82,18 +93,13 @@ class RigidBodies:
         """Register YADE bodies (an id or a list) as one contact group with friction coefficient mu [-],
         cohesion [Pa], residual penetration factor chi [-] and detection distance d0 [m] (None: half the
         particle edge); thickness [m] overrides the 2D z-extent. Returns the group index."""
-        from yade import O
         _check_params(mu, cohesion, chi, d0, thickness)
         ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
         if not ids:
             raise ValueError("ids: give at least one YADE body id")
         bodies = []
         for i in ids:
-            if not isinstance(i, (int, np.integer)) or i < 0 or i >= len(O.bodies) or O.bodies[int(i)] is None:
-                raise ValueError(f"body id {i!r} does not exist in O.bodies")
-            b = O.bodies[int(i)]
-            if b.isClumpMember:
-                raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
+            b = _yade_body(i)
             if int(i) in self._part_of:
                 raise ValueError(f"body id {i} is already registered for contact")
             bodies.append(b)

@@ -31,13 +31,26 @@ plane (``blockedDOFs = 'zXY'``); the trace is taken at registration.
 
 Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation).
 """
+import functools
 import math
 import time
 
 import numpy as np
 
-from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec
+from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec, _yade_body
 from .scene import dim_of
+
+
+def _timed(method):
+    """Adds the wall time of each call to self.wall (the Python side of the coupling, for the benchmark)."""
+    @functools.wraps(method)
+    def wrapper(self):
+        t0 = time.perf_counter()
+        try:
+            return method(self)
+        finally:
+            self.wall += time.perf_counter() - t0
+    return wrapper
 
 
 class DemSpheres:
@@ -61,11 +74,7 @@ class DemSpheres:
         s, d = solver, self.dim
         rows = []
         for i in ids:
-            if not isinstance(i, (int, np.integer)) or i < 0 or i >= len(O.bodies) or O.bodies[int(i)] is None:
-                raise ValueError(f"body id {i!r} does not exist in O.bodies")
-            b = O.bodies[int(i)]
-            if b.isClumpMember:
-                raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
+            b = _yade_body(i)
             kind = self._kind(b)
             if kind is None:
                 raise ValueError(f"body id {i} has shape {type(b.shape).__name__}; DemSpheres takes spheres and clumps of "
@@ -179,15 +188,9 @@ class DemSpheres:
         k = int(min(T / dt, self.max_check_steps))
         self._next_check = s.steps + max(1, min(self.max_check_steps, k))
 
+    @_timed
     def read(self):
         """Before the MPM step: broad phase when due, then the kinematics of the active bodies."""
-        t0 = time.perf_counter()
-        try:
-            self._read()
-        finally:
-            self.wall += time.perf_counter() - t0
-
-    def _read(self):
         from yade import O
         s, d = self.solver, self.dim
         if s.steps >= self._next_check:
@@ -211,15 +214,9 @@ class DemSpheres:
         w = np.array([[q.angVel[2]] for q in st]) if d == 2 else np.array([[q.angVel[a] for a in range(3)] for q in st])
         s.setRigidPartMotions(self.parts[k], x, v, w)
 
+    @_timed
     def write(self):
         """After the MPM step: reactions of the active bodies into O.forces (2D: × thickness)."""
-        t0 = time.perf_counter()
-        try:
-            self._write()
-        finally:
-            self.wall += time.perf_counter() - t0
-
-    def _write(self):
         from yade import O
         from yade import Vector3
         k = np.nonzero(self.active)[0]
