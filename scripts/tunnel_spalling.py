@@ -32,6 +32,8 @@ from yade_mpm import analysis, cases, checkpoint, output, rocks, runner
 SNAPSHOTS_MS = (8.0, 12.0, 20.0)          # field pictures (Figs. 18a–c, 19)
 CURVE_STEP_MM = 0.1                       # summary.json: axial stress every 0.1 mm
 RECORD_STEP_MM = 0.01                     # CSV: mean platen stress over every 0.01 mm of displacement
+BAND_GAP = 5e-3                          # shear bands are looked for beyond this distance from the opening [m]
+BAND_FRACTION, BAND_MIN = 0.5, 5e-4      # band particles: ε̄p ≥ max(BAND_MIN, BAND_FRACTION × its 99th percentile there)
 DEFAULT_SPACING = 2e-3                    # default grid [m] (README main command: four cases < 20 min)
 PAPER_SPACING = 1e-3                      # paper Sec. 4
 
@@ -44,9 +46,10 @@ def parse():
     ap.add_argument("--spacing", type=float, default=None, help=f"grid spacing l [m] (default {DEFAULT_SPACING})")
     ap.add_argument("--paper", action="store_true", help=f"the paper's grid, l = {PAPER_SPACING} m (83 k particles)")
     ap.add_argument("--end-time", type=float, default=cases.TUNNEL_END_TIME, help="loading time [s] (default 0.02)")
-    ap.add_argument("--courant", type=float, default=0.5, help="Courant number C of Δt = C·l/(v_c + max|v|) (default 0.5)")
+    ap.add_argument("--courant", type=float, default=0.5,
+                    help="Courant number C of Δt = C·l/(v_c + max|v|) (default 0.5; C = 1, the paper's Δt, inverts the platen corner)")
     ap.add_argument("--threads", type=int, default=None, help="OpenMP threads (default: all cores)")
-    ap.add_argument("--vtu-every", type=float, default=2e-3, help="simulated seconds between VTU files (default 0.002)")
+    ap.add_argument("--vtu-every", type=float, default=4e-3, help="simulated seconds between VTU files, plus 8, 12, 20 ms (default 0.004)")
     ap.add_argument("--checkpoint-every", default="5min",
                     help="checkpoint period: N (steps) or Nmin (wall minutes); 0 = only at the end/interrupt (default 5min)")
     ap.add_argument("--resume", action="store_true", help="continue unfinished cases from OUT/CASE/checkpoint.ckpt; keep finished ones")
@@ -104,6 +107,7 @@ class CaseRun:
         self.x0 = ym.get(s, "pos")                             # initial positions by id
         self.lattice = analysis.Lattice(self.x0, self.dp, origin=(0, 0))
         self.rock = self._rock_mask()
+        self.dist = cases.tunnel_opening_distance(self.x0)
         from yade import O
         self.platen_y0 = O.bodies[self.bodies["platen"]].state.pos[1]
         # recorder state (saved with each checkpoint)
@@ -182,6 +186,8 @@ class CaseRun:
         if resumed and s.time >= a.end_time * (1 - runner.TIME_TOL):   # finished (a larger --end-time continues it)
             self.state["done"] = True
             return self
+        if not resumed:
+            self.geometry_picture()
         n = s.numParticles
         print(f"[{self.case}] {n} particles, l = {s.spacing * 1e3:g} mm, Δt ≈ {s.stableDt() * 1e6:.3f} µs, "
               f"{a.end_time / s.stableDt():.0f} steps to {a.end_time * 1e3:g} ms", flush=True)
@@ -191,16 +197,26 @@ class CaseRun:
         ck = checkpoint.Checkpointer(self.ckpt, every_steps=a.ck_steps, every_minutes=a.ck_minutes, meta=self.meta,
                                      extra=lambda: self.state)
         times = [t * 1e-3 for t in SNAPSHOTS_MS if t * 1e-3 <= a.end_time + 1e-12]
-        vtu_times = list(np.arange(0.0, a.end_time + 1e-12, a.vtu_every))
+        vtu_times = sorted(set(np.arange(0.0, a.end_time + 1e-12, a.vtu_every).tolist()) | set(times))
         outs = [runner.Output(self.record, steps=1), runner.Output(self.watch_damage, steps=10),
                 runner.Output(self.snapshot, times=times, at_end=True),
                 runner.Output(series.write, times=vtu_times, at_end=True), ck.output(steps=50)]
         wall0 = time.time()
         steps0 = s.steps
+        self.failed = None
         with ck.signals():
-            res = runner.run(s, end_time=a.end_time, progress=a.progress, label=self.case, outputs=outs, advance=O.step)
+            try:
+                res = runner.run(s, end_time=a.end_time, progress=a.progress, label=self.case, outputs=outs, advance=O.step)
+            except RuntimeError as e:                        # YADE wraps the solver's MpmSimulationError
+                self.failed = str(self.bodies["engine"].error or e)
         self.state["wall"] += time.time() - wall0
         self.state["steps_run"] += s.steps - steps0
+        if self.failed:                                       # half-updated state: no checkpoint, the outputs so far
+            self.state["final_displacement"] = self.displacement()
+            self.state["error"] = self.failed
+            print(f"[{self.case}] stopped by the solver: {self.failed}", flush=True)
+            self.interrupted = True
+            return self
         self.state["done"] = res.reason == "end_time"
         self.state["final_displacement"] = self.displacement()
         ck.save(s.steps)                                      # the last state: resumable, or the finished run
@@ -209,6 +225,37 @@ class CaseRun:
                   f"rerun with --resume to continue", flush=True)
         self.interrupted = ck.stop_requested
         return self
+
+    def geometry_picture(self):
+        """The scene as built (paper Fig. 16): particles by material, the platen, the filler, the flaw."""
+        from yade import O
+        plt = output.pyplot()
+        from matplotlib.patches import Polygon as Patch
+        fig, ax = plt.subplots(figsize=(4.6, 4.8))
+        x = self.x0 * 1e3
+        ax.scatter(x[self.rock, 0], x[self.rock, 1], s=0.3, c="tan", marker="s", linewidths=0, label="sandstone")
+        if (~self.rock).any():
+            ax.scatter(x[~self.rock, 0], x[~self.rock, 1], s=0.3, c="tab:green", marker="s", linewidths=0, label="grout")
+        for bid, color, name in ((self.bodies["platen"], "tab:blue", "rigid platen"), (self.bodies["filler"], "tab:red", "rigid filler")):
+            if bid is None:
+                continue
+            b = O.bodies[bid]
+            e, q, c = b.shape.extents, b.state.ori, b.state.pos
+            R = np.array([[q.toRotationMatrix()[i, j] for j in range(2)] for i in range(2)])
+            corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [e[0], e[1]]
+            ax.add_patch(Patch((corners @ R.T + [c[0], c[1]]) * 1e3, closed=True, fc=color, alpha=0.6, label=name))
+        fl = self.bodies["flaw"]
+        if fl is not None:
+            ax.plot(*(np.array([fl["toe"], fl["tip"]]) * 1e3).T, "k:", lw=0.8)
+            ax.annotate("flaw toe", fl["toe"] * 1e3, xytext=(8, -14), textcoords="offset points", fontsize=7)
+        ax.set_aspect("equal")
+        ax.set_xlim(-3, 153), ax.set_ylim(-3, 163)
+        ax.set_xlabel("x [mm]"), ax.set_ylabel("y [mm]")
+        ax.set_title(f"{self.case}: {self.solver.numParticles} particles, l = {self.solver.spacing * 1e3:g} mm", fontsize=9)
+        ax.legend(fontsize=7, loc="lower left", markerscale=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(self.dir, "geometry.png"), dpi=110)
+        plt.close(fig)
 
     # ---- analysis and pictures
     def analyse(self):
@@ -227,7 +274,11 @@ class CaseRun:
             failed = self.rock & ((f["damage"] >= 1.0) | (f["epsP"] >= soft_end))
             sp = analysis.spalled(failed, self.lattice, opening, f["mass"])
             shear = self.rock & (f["epsP"] >= soft_end)
-            bands = analysis.bands(shear, self.lattice)
+            # shear bands: localised plastic strain (not the tensile cracks) away from the opening's plastic rim
+            zone = self.rock & (f["damage"] < 1) & (self.dist > BAND_GAP)
+            ref = float(np.percentile(f["epsP"][zone], 99)) if zone.any() else 0.0
+            thr = max(BAND_MIN, BAND_FRACTION * ref)
+            bands = analysis.bands(zone & (f["epsP"] >= thr), self.lattice)
             for b in bands:
                 b["side"] = "left" if b["centroid"][0] < cx else "right"
                 b["location"] = cases.tunnel_location(b["centroid"], self.bodies["flaw"])
@@ -249,7 +300,7 @@ class CaseRun:
                 spalled_area_mm2=sp["area"] * 1e6, spalled_mass_kg_per_m=sp["mass"], spalled_particles=int(sp["mask"].sum()),
                 spalled_fragments=sp["fragments"],
                 spalling_at=self._where(self.x0[surf]) if surf.any() else None,
-                bands=bands[:6], **toe)
+                band_threshold=thr, bands=bands[:6], **toe)
             f["spalled"] = sp["mask"]
         self.snaps, self.result = snaps, res
         return res
@@ -283,12 +334,14 @@ class CaseRun:
         for key, f in sorted(self.snaps.items()):
             info = self.result["snapshots"][key]
             pos, disp = f["pos"] * 1e3, (f["pos"] - self.x0) * 1e3
-            panels = [("accumulated plastic strain ε̄p [-]", f["epsP"], "viridis", (0, 0.1)),
-                      ("damage D [-]", f["damage"], "inferno", (0, 1)),
+            e_top = max(float(np.percentile(f["epsP"][self.rock], 99.5)), 1e-6)
+            panels = [("accumulated plastic strain ε̄p [-] (to its 99.5th pct.)", f["epsP"], "viridis", (0, e_top)),
+                      ("damage D [-] (cyan: spalled region)", f["damage"], "inferno", (0, 1)),
                       ("max tensile principal stress σ̃max [MPa]", np.maximum(f["smax"], 0) / 1e6, "magma", None),
                       ("x displacement [mm]", disp[:, 0], "coolwarm", "sym"),
                       ("y displacement [mm]", disp[:, 1], "viridis", None)]
-            fig, axs = plt.subplots(1, 5, figsize=(24, 5.2))
+            fig, axs = plt.subplots(2, 3, figsize=(15, 10.4))
+            axs = axs.ravel()
             ms = max(0.05, 60.0 * (self.dp * 1e3) ** 2 / 4)
             for ax, (title, v, cmap, lim) in zip(axs, panels):
                 if lim == "sym":
@@ -298,23 +351,36 @@ class CaseRun:
                     norm = Normalize(np.min(v), np.max(v) if np.max(v) > np.min(v) else np.min(v) + 1)
                 else:
                     norm = Normalize(*lim)
-                sc = ax.scatter(pos[:, 0], pos[:, 1], c=v, s=ms, cmap=cmap, norm=norm, marker="s", linewidths=0)
-                ax.set_title(title, fontsize=10)
+                sc = ax.scatter(pos[:, 0], pos[:, 1], c=v, s=ms, cmap=cmap, norm=norm, marker="s", linewidths=0, rasterized=True)
+                ax.set_title(title, fontsize=9)
                 ax.set_aspect("equal")
-                ax.set_xlim(-2, 152), ax.set_ylim(-2, 160)
-                ax.set_xlabel("x [mm]")
-                fig.colorbar(sc, ax=ax, shrink=0.75)
-            axs[0].set_ylabel("y [mm]")
+                ax.set_xlim(-2, 152), ax.set_ylim(-2, 154)
+                ax.set_xlabel("x [mm]"), ax.set_ylabel("y [mm]")
+                fig.colorbar(sc, ax=ax, shrink=0.8)
+            for b in info["bands"]:                            # detected shear bands: principal axes
+                c, h, a = np.array(b["centroid"]) * 1e3, 0.5 * b["length"] * 1e3, np.radians(b["angle_deg"])
+                u = h * np.array([np.cos(a), np.sin(a)])
+                axs[0].plot(*np.array([c - u, c + u]).T, "r-", lw=1)
+                axs[0].annotate(f"{abs(b['angle_deg']):.0f}°", c + u, color="r", fontsize=8)
             sp = f["spalled"]
-            if sp.any():                                       # spalled region outlined on the damage panel
+            if sp.any():
                 axs[1].scatter(pos[sp, 0], pos[sp, 1], s=ms * 1.6, facecolors="none", edgecolors="cyan", linewidths=0.3, marker="s")
-            axs[1].text(0.02, 0.98, f"spalled: {info['spalled_area_mm2']:.0f} mm², {info['spalled_mass_kg_per_m']:.3f} kg/m"
-                        f"\nsymmetry(D) = {_fmt(info['symmetry_damage'])}", transform=axs[1].transAxes, va="top",
-                        fontsize=8, color="white", bbox=dict(facecolor="black", alpha=0.5, lw=0))
-            fig.suptitle(f"{self.case}: t = {info['time_ms']:.1f} ms, platen displacement {info['displacement_mm']:.2f} mm "
-                         f"(grid {self.solver.spacing * 1e3:g} mm, {self.solver.numParticles} particles)")
+            axs[5].axis("off")
+            lines = [f"{self.case}", f"t = {info['time_ms']:.1f} ms, platen displacement {info['displacement_mm']:.2f} mm",
+                     f"grid {self.solver.spacing * 1e3:g} mm, {self.solver.numParticles} particles", "",
+                     f"spalled / failed zone at the opening: {info['spalled_area_mm2']:.0f} mm²",
+                     f"   {info['spalled_mass_kg_per_m']:.3f} kg per m of tunnel, at: {info['spalling_at'] or '—'}",
+                     f"damage symmetry {_fmt(info['symmetry_damage'])}, plastic strain symmetry {_fmt(info['symmetry_plastic'])}",
+                     f"D = 1 in {100 * info['damaged_fraction']:.2f} % of the rock",
+                     "shear bands (ε̄p ≥ %.1e, beyond %g mm):" % (info["band_threshold"], BAND_GAP * 1e3)]
+            lines += [f"   {b['side']}: {abs(b['angle_deg']):.0f}° to the horizontal, {b['length'] * 1e3:.0f} mm, {b['location']}"
+                      for b in info["bands"][:5]] or ["   none"]
+            if "toe_damaged" in info:
+                lines += [f"flaw toe (4 mm): {info['toe_damaged']} with D = 1, {info['toe_softened']} softened",
+                          f"   failed zone from the toe reaches: {info['toe_link_to_opening'] or 'nowhere'}"]
+            axs[5].text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, family="monospace", transform=axs[5].transAxes)
             fig.tight_layout()
-            fig.savefig(os.path.join(self.dir, f"fields_{key}.png"), dpi=110)
+            fig.savefig(os.path.join(self.dir, f"fields_{key}.png"), dpi=90)
             plt.close(fig)
 
     def text(self, entry):
@@ -322,7 +388,7 @@ class CaseRun:
         L = [f"== {self.case} ==",
              f"grid {self.solver.spacing * 1e3:g} mm, {entry['particles']} particles, {entry['steps']} steps, wall {st['wall']:.1f} s, "
              f"{(entry['particle_steps_per_s'] or 0) / 1e6:.2f} M particle-steps/s, final displacement {entry['final_displacement_mm']:.3f} mm"
-             + ("" if st["done"] else "  [UNFINISHED: rerun with --resume]")]
+             + ("" if st["done"] else (f"  [STOPPED BY THE SOLVER: {st['error']}]" if st.get("error") else "  [UNFINISHED: rerun with --resume]"))]
         fc = st["first_crack"]
         L.append("first tensile crack (D = 1): " + (f"{fc['location']} at t = {fc['time'] * 1e3:.2f} ms, displacement "
                                                      f"{fc['displacement'] * 1e3:.3f} mm ({fc['particles']} particles)" if fc else "none"))
@@ -395,6 +461,7 @@ def main():
         if getattr(r, "interrupted", False):
             interrupted = True
             break
+    failed = [r.case for r in runs if getattr(r, "failed", None)]
     entries = [r.summary_entry() for r in runs]
     output.write_summary(a.out, {"cases": entries})
     plot_curves(runs, a.out)
@@ -405,6 +472,9 @@ def main():
     open(os.path.join(a.out, "summary.txt"), "w").write("\n\n".join(txt) + "\n")
     print("\n\n".join(txt))
     print(f"results in {os.path.abspath(a.out)}")
+    if failed:
+        print(f"stopped by the solver in: {', '.join(failed)} (outputs written up to the stop)", file=sys.stderr)
+        sys.exit(1)
     if interrupted:
         sys.exit(0)
 

@@ -207,8 +207,10 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
         hl, hw = _filler_half_sizes(s, flaw, ppc)
         ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
         from yade.minieigenHP import Quaternion, Vector3
+        from yade.wrapper import FrictMat
+        fmat = O.materials.append(FrictMat(density=rock.density, label="filler"))   # the filler weighs as the rock
         filler = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, thick),
-                                           orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False))
+                                           orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, material=fmat))
         O.bodies[filler].state.blockedDOFs = "zXY"  # in the plane: x, y, rotation about z
         rb.add(filler, mu=filler_friction)
     eng = MpmEngine(s, label=label, bodies=rb)
@@ -261,3 +263,14 @@ def tunnel_location(point, flaw=None):
     if y < floor + 0.005:
         return f"{side} corner" if abs(x - cx) > hw - 0.003 else "floor"
     return f"{side} wall"
+
+
+def tunnel_opening_distance(points, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect=TUNNEL_RECT, radius=TUNNEL_RADIUS):
+    """Distance [m] of points (N, 2) from the arch opening of ``arch_tunnel_holes`` (0 inside)."""
+    p = np.asarray(points, float)
+    cx, hw, top = width / 2, rect[0] / 2, floor + rect[1]
+    dx = np.maximum(np.abs(p[:, 0] - cx) - hw, 0.0)
+    dy = np.maximum(np.maximum(floor - p[:, 1], p[:, 1] - top), 0.0)
+    d_rect = np.hypot(dx, dy)
+    d_arch = np.maximum(np.hypot(p[:, 0] - cx, p[:, 1] - top) - radius, 0.0)
+    return np.minimum(d_rect, d_arch)
