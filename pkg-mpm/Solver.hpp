@@ -13,6 +13,7 @@
 #include "GridUpdate.hpp"
 #include "MaterialSet.hpp"
 #include "ParticleUpdate.hpp"
+#include "SolverSettings.hpp"
 #include <omp.h>
 
 namespace mpm {
@@ -28,24 +29,16 @@ public:
 	using Vec  = typename Dim<D>::Vec;
 	using IVec = typename Dim<D>::IVec;
 
-	// ---- settings (each validated where it is set) ----
-	Vec  gravity          = Vec::Zero(); // g [m/s²]
-	Real damping          = 0;   // Cundall local damping α on nodal forces: f ← f − α|f|sign(v) [-], 0 ≤ α < 1
-	Real courant          = 0.5; // C in Δt = C·l/(v_c + max‖v‖) [-], 0 < C ≤ 1
-	bool autoDt           = true; // recompute Δt every step from the stability condition
-	Real fixedDt          = 0;   // Δt used when autoDt is false [s]
-	Real tractionRampTime = 0;   // particle surface forces ramp linearly from 0 over this time [s]; 0 = at once
-	int  sortPeriod       = 50;  // re-sort particles by block at least every this many steps
-	bool trackEnergy      = false; // accumulate external work (costs one extra pass)
+	// ---- settings (gravity, damping, courant, autoDt, fixedDt, …) and writable state (time, externalWork),
+	// declared once in SolverSettings.hpp; the binding checks every value written from Python ----
+	MPM_PARAMS(Solver, NoParams, MPM_SOLVER_PARAMS)
 
 	// ---- state ----
 	Grid<D>         grid;
 	Particles<D>    P;
 	ContactPhase<D> contact;
-	Real            time = 0;   // simulated time [s]
 	long            steps = 0;
 	Real            lastDt = 0; // Δt of the last step [s]
-	Real            externalWork = 0; // work of gravity and surface forces on the particles [J] (trackEnergy)
 	PhaseTimes      phase;
 
 	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { }
@@ -104,17 +97,6 @@ public:
 		for (int a = 0; a < D; ++a) requireFinite(f[a], "particle surface force");
 		P.ensureTraction();
 		for (int a = 0; a < D; ++a) P.trac[a][p] = f[a];
-	}
-
-	void setSetting(const char* name, Real v)
-	{
-		std::string n(name);
-		if (n == "damping") requireRange(v, 0, 1, false, true, "damping", "[-]"), damping = v;
-		else if (n == "courant") requireRange(v, 0, 1, true, false, "courant", "[-]"), courant = v;
-		else if (n == "fixedDt") requireRange(v, 0, INFINITY, true, true, "fixedDt", "[s]"), fixedDt = v;
-		else if (n == "tractionRampTime") requireRange(v, 0, INFINITY, false, true, "tractionRampTime", "[s]"), tractionRampTime = v;
-		else if (n == "sortPeriod") requireRange(v, 1, 1e9, false, false, "sortPeriod", "[steps]"), sortPeriod = int(v);
-		else throw InputError("unknown setting " + n);
 	}
 
 	// ---------------------------------------------------------------- time step

@@ -285,12 +285,37 @@ struct SolverWrap {
 		const long long n = argInt(steps, who("run: steps"), 0, 9.2e18);
 		for (long long k = 0; k < n; ++k) s.step();
 	}
-	static bp::tuple getGravity(S& s) { return fromVec<D>(s.gravity); }
-	static void setGravity(S& s, bp::object g)
+	// Settings (SolverSettings.hpp) as a dict, and written back all or nothing.
+	static bp::dict settings(const S& s)
 	{
-		auto v = toVec<D>(g, "gravity");
-		for (int a = 0; a < D; ++a) requireFinite(v[a], "gravity");
-		s.gravity = v;
+		bp::dict d, all = ParamBinding<S>::toDict(s);
+		for (const char* n : settingNames()) d[n] = all[n];
+		return d;
+	}
+	static void setSettings(S& s, bp::dict d)
+	{
+		const bp::dict old = settings(s);
+		bp::list       keys = d.keys();
+		for (long i = 0; i < bp::len(keys); ++i) {
+			std::string k = bp::extract<std::string>(bp::str(keys[i]));
+			bool        known = false;
+			for (const char* n : settingNames()) known = known || k == n;
+			if (!known) throw InputError(who("setSettings") + ": unknown setting '" + k + "'; known: " + bp::extract<std::string>(bp::str(", ").join(old.keys()))());
+		}
+		try {
+			for (long i = 0; i < bp::len(keys); ++i) ParamBinding<S>::set(s, bp::extract<std::string>(keys[i]), d[keys[i]]);
+		} catch (...) {
+			bp::list ok = old.keys();
+			for (long i = 0; i < bp::len(ok); ++i) ParamBinding<S>::set(s, bp::extract<std::string>(ok[i]), old[ok[i]]);
+			throw;
+		}
+	}
+	static const std::vector<const char*>& settingNames()
+	{
+#define MPM_NAME_(T, name, ...) #name,
+		static const std::vector<const char*> n { MPM_SOLVER_SETTINGS(MPM_NAME_) };
+#undef MPM_NAME_
+		return n;
 	}
 	static size_t numParticles(S& s) { return s.P.n; }
 	static size_t bytesPerParticle(S& s) { return s.P.bytesPerParticle(); }
@@ -495,19 +520,13 @@ struct SolverWrap {
 
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
-	// Settings are routed through one validating setter so every bad value raises ValueError.
-	template <Real S::*field>
-	static Real getR(S& s) { return s.*field; }
-	static void setDamping(S& s, double v) { s.setSetting("damping", v); }
-	static void setCourant(S& s, double v) { s.setSetting("courant", v); }
-	static void setFixedDt(S& s, double v) { s.setSetting("fixedDt", v); }
-	static void setRamp(S& s, double v) { s.setSetting("tractionRampTime", v); }
-	static int  getSortPeriod(S& s) { return s.sortPeriod; }
-	static void setSortPeriod(S& s, int v) { s.setSetting("sortPeriod", v); }
-
 	static void expose(const char* name)
 	{
-		bp::class_<S, std::shared_ptr<S>, boost::noncopyable>(name, "Explicit WLS-MPM solver (MUSL) on a fixed regular grid.", bp::no_init)
+		ParamBinding<S>::declare(name);
+		bp::class_<S, std::shared_ptr<S>, boost::noncopyable> cls(name, "Explicit WLS-MPM solver (MUSL) on a fixed regular grid.", bp::no_init);
+		ParamBinding<S>::exposeProperties(cls); // settings and writable state, checked (SolverSettings.hpp)
+		cls.def("settings", &settings, "The settings (SolverSettings.hpp) as a dict {name: value}.")
+		        .def("setSettings", &setSettings, bp::arg("settings"), "Write settings from a dict (all or nothing; unknown names refused).")
 		        .def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"))))
 		        .def("addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses"), bp::arg("material") = 0),
 		             "Adds particles (positions (N, D) [m], volumes [m³], masses [kg]) of material index `material` (addMaterial's return value).")
@@ -569,18 +588,8 @@ struct SolverWrap {
 		        .add_property("origin", &getOrigin)
 		        .add_property("cells", &getCells)
 		        .add_property("storedNodes", &getStored)
-		        .add_property("gravity", &getGravity, &setGravity)
-		        .add_property("damping", &getR<&S::damping>, &setDamping)
-		        .add_property("courant", &getR<&S::courant>, &setCourant)
-		        .add_property("fixedDt", &getR<&S::fixedDt>, &setFixedDt)
-		        .add_property("tractionRampTime", &getR<&S::tractionRampTime>, &setRamp)
-		        .add_property("sortPeriod", &getSortPeriod, &setSortPeriod)
-		        .def_readwrite("autoDt", &S::autoDt)
-		        .def_readwrite("trackEnergy", &S::trackEnergy)
-		        .def_readwrite("time", &S::time)
 		        .def_readonly("steps", &S::steps)
 		        .def_readonly("lastDt", &S::lastDt)
-		        .def_readwrite("externalWork", &S::externalWork)
 		        .add_property("maxSpeed", &S::maxSpeed);
 	}
 };

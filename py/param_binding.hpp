@@ -201,13 +201,7 @@ struct ParamBinding {
 		cls.def("paramTable", &table, "The parameter declarations: one dict per parameter.");
 		cls.staticmethod("paramTable");
 		cls.def("validate", &S::validate, "Raise ValueError naming the first parameter outside its range (or conditions that tie parameters).");
-		S::forEachMember([&](const ParamInfo& p, auto mp) {
-			using T   = std::decay_t<decltype(std::declval<S&>().*mp)>;
-			auto get  = [mp](const S& s) { return paramToPy(s.*mp); };
-			auto put  = [mp, p](S& s, bp::object v) { s.*mp = pyToParam<T>(v, clsName() + "." + p.name, p); };
-			cls.add_property(p.name, bp::make_function(get, bp::default_call_policies(), boost::mpl::vector<bp::object, const S&>()),
-			                 bp::make_function(put, bp::default_call_policies(), boost::mpl::vector<void, S&, bp::object>()), p.describe().c_str());
-		});
+		exposeProperties(cls);
 		for (auto& [a, t] : aliases()) {
 			std::string target = t, alias = a;
 			auto get = [target](bp::object self) { return self.attr(target.c_str()); };
@@ -216,6 +210,18 @@ struct ParamBinding {
 			                 bp::make_function(put, bp::default_call_policies(), boost::mpl::vector<void, bp::object, bp::object>()),
 			                 ("alias of " + target).c_str());
 		}
+	}
+	// One checked property per parameter (also for classes without the keyword constructor, e.g. the solver).
+	template <class Cls>
+	static void exposeProperties(Cls& cls)
+	{
+		S::forEachMember([&](const ParamInfo& p, auto mp) {
+			using T   = std::decay_t<decltype(std::declval<S&>().*mp)>;
+			auto get  = [mp](const S& s) { return paramToPy(s.*mp); };
+			auto put  = [mp, p](S& s, bp::object v) { s.*mp = pyToParam<T>(v, clsName() + "." + p.name, p); };
+			cls.add_property(p.name, bp::make_function(get, bp::default_call_policies(), boost::mpl::vector<bp::object, const S&>()),
+			                 bp::make_function(put, bp::default_call_policies(), boost::mpl::vector<void, S&, bp::object>()), p.describe().c_str());
+		});
 	}
 };
 

@@ -111,3 +111,47 @@ def test_weibull_modulus_outside_physical_range_refused():
     assert m.activationStrain(4e-4) == pytest.approx(3.77e-4, rel=2e-3)  # paper's k, m; V = (2 cm)²·1 m (Eq. 37 by hand)
     with pytest.raises(ValueError, match=r"weibullM = 1e-300 \[-\] is outside the allowed range \[1, 50\]"):
         ym.DpGkMat(**dict(ROCK, weibullM=1e-300))
+
+
+@pytest.mark.parametrize("cls", [ym.Solver2D, ym.Solver3D])
+def test_every_writable_solver_attribute_is_declared_with_unit_and_range(cls):
+    """Settings and writable state (SolverSettings.hpp): every property a script can assign is declared
+    once and documents its unit and range; no raw writable field is left (time, externalWork, autoDt …)."""
+    writable = sorted(n for n in dir(cls) if not n.startswith("_") and isinstance(getattr(cls, n), property)
+                      and getattr(cls, n).fset is not None)
+    assert {"gravity", "damping", "courant", "autoDt", "fixedDt", "tractionRampTime", "sortPeriod", "trackEnergy",
+            "time", "externalWork"} <= set(writable)
+    for n in writable:
+        doc = getattr(cls, n).__doc__ or ""
+        assert UNIT.search(doc) and RANGE.search(doc), f"{cls.__name__}.{n}: {doc!r}"
+
+
+@pytest.mark.parametrize("name, value, msg", [
+    ("time", -1.0, r"Solver2D.time = -1 \[s\] is outside the allowed range \[0, inf\)"),   # reversed ramped tractions
+    ("time", math.nan, r"Solver2D.time = nan \[s\] is outside"),                          # ran on with NaN time
+    ("externalWork", math.inf, r"Solver2D.externalWork = inf \[J\] is outside"),
+    ("autoDt", "yes", r"Solver2D.autoDt must be True or False \(got str"),                # Boost ArgumentError
+    ("damping", "a", r"Solver2D.damping must be a number \[-\] in \[0, 1\)"),
+    ("sortPeriod", 10 ** 20, r"Solver2D.sortPeriod = 100000000000000000000 is outside the allowed range \[1, 1000000000\]"),
+    ("gravity", (0, math.nan), r"Solver2D.gravity\[1\] = nan \[m/s²\] is outside"),
+])
+def test_solver_settings_and_state_checked(name, value, msg):
+    s = ym.make_solver((0, 0), (1, 1), 0.1)
+    before = s.settings()
+    with pytest.raises(ValueError, match=msg):
+        setattr(s, name, value)
+    assert s.settings() == before and s.time == 0
+
+
+def test_solver_settings_round_trip_all_or_nothing():
+    s = ym.make_solver((0, 0), (1, 1), 0.1)
+    new = dict(s.settings(), damping=0.3, courant=0.25, gravity=(0.0, -9.81), autoDt=False, fixedDt=1e-6, sortPeriod=7)
+    s.setSettings(new)
+    t = ym.make_solver((0, 0), (1, 1), 0.1)
+    t.setSettings(json.loads(json.dumps(s.settings())))      # through JSON, as a checkpoint is
+    assert t.settings() == dict(new, gravity=(0.0, -9.81))
+    with pytest.raises(ValueError, match=r"courant = 2 \[-\] is outside the allowed range \(0, 1\]"):
+        t.setSettings({"damping": 0.1, "courant": 2.0})
+    assert t.damping == 0.3                                     # the valid part was not applied either
+    with pytest.raises(ValueError, match="unknown setting 'dampng'"):
+        t.setSettings({"dampng": 0.1})

@@ -1,0 +1,24 @@
+// The solver settings and the user-writable solver state, each declared once (columns: ParamTable.hpp).
+// Solver<D> expands these lists into its plain fields with MPM_PARAMS; the binding generates the checked
+// Python properties (unit and range in the docstring) and Solver.settings()/setSettings() from them.
+#pragma once
+#include "ParamTable.hpp"
+
+// X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate); Vec = Dim<D>::Vec (per component)
+#define MPM_SOLVER_SETTINGS(X)                                                                                                    \
+	X(Vec, gravity, 0, "m/s²", -INFINITY, INFINITY, OO, "g", "gravitational acceleration", "Eq. 22", "")                        \
+	X(Real, damping, 0, "-", 0, 1, CO, "α", "Cundall local damping of the nodal forces, f ← f − α|f|sign(v)", "", "")           \
+	X(Real, courant, 0.5, "-", 0, 1, OC, "C", "Courant number of the automatic step Δt = C·l/(v_c + max‖v‖)", "Sec. 2.5", "")    \
+	X(bool, autoDt, true, "-", 0, 1, CC, "", "recompute Δt every step from the stability condition (else fixedDt)", "", "")     \
+	X(Real, fixedDt, 0, "s", 0, INFINITY, CO, "Δt", "time step used when autoDt is off (0 = not set; must be > 0 then)", "", "") \
+	X(Real, tractionRampTime, 0, "s", 0, INFINITY, CO, "", "particle surface forces ramp linearly from 0 over this time; 0 = at once", \
+	  "Eq. 22", "")                                                                                                              \
+	X(int, sortPeriod, 50, "steps", 1, 1e9, CC, "", "re-sort particles by block at least every this many steps", "", "")        \
+	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")
+
+#define MPM_SOLVER_PARAMS(X) MPM_SOLVER_SETTINGS(X) MPM_SOLVER_STATE(X)
+
+// State a script may set (resume, restart): checked like the settings, not part of settings().
+#define MPM_SOLVER_STATE(X)                                                                                          \
+	X(Real, time, 0, "s", 0, INFINITY, CO, "t", "simulated time (ramped tractions are evaluated at it)", "", "")   \
+	X(Real, externalWork, 0, "J", -INFINITY, INFINITY, OO, "W_ext", "work of gravity and surface forces (trackEnergy)", "", "")
