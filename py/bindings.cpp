@@ -146,6 +146,7 @@ struct SolverWrap {
 		std::string kind = bp::extract<std::string>(raw.attr("dtype").attr("kind"));
 		if (bp::len(raw.attr("shape")) != 1 || (kind != "i" && kind != "u" && bp::len(raw) > 0))
 			throw InputError(who("setParticleForces: indices") + " must be a 1-D array of integer particle slots (got " + pyTypeName(idx.ptr()) + " " + pyRepr(idx) + ")");
+		if (bp::len(raw) == 0) raw = raw.attr("astype")("int64"); // [] is float64 to NumPy
 		np::ndarray i = np::from_object(raw, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
 		size_t      n = i.shape(0);
 		np::ndarray f = asDoubleArray(forces, "forces", D, n);

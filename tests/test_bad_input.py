@@ -295,6 +295,7 @@ def test_damage_threshold_outside_unit_interval_refused():
 @pytest.mark.parametrize("call, msg", [
     (lambda: _solver().setParticleForces(np.zeros(1), [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
     (lambda: _solver().setParticleForces(10 ** 20, [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
+    (lambda: _solver().setParticleForces([], []), r"forces must be an \(N, 2\) array"),
     (lambda: ym.make_solver((0, 0), (1, 1), True), r"spacing must be a number \[m\] \(got bool True\)"),
     (lambda: ym.get(None, "pos"), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
     (lambda: ym.MpmEngine(None), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
