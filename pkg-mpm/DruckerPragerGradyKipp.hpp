@@ -62,6 +62,9 @@ struct DpGkMat : ElasticMat {
 	}
 };
 
+// The parameter tables add no runtime state: hot loops copy and read plain structs.
+static_assert(std::is_trivially_copyable_v<ElasticMat> && std::is_trivially_copyable_v<DpGkMat>, "material parameters must stay plain data");
+
 // Result of a single DP return, exposed for the single-particle tests.
 struct ReturnInfo {
 	int  mode    = 0; // 0 elastic, 1 cone, 2 apex

@@ -51,7 +51,7 @@ def parse_args(argv=None):
     p.add_argument("--boundary-load", choices=("consistent", "outer-row"), default="consistent",
                    help="far-field traction on the outer 3·ppc particle rows with weights that keep the intact "
                         "block in exact discrete equilibrium (default), or on the outermost row only")
-    p.add_argument("--damping", type=float, default=0.5, help="Cundall local damping α, 0 ≤ α < 1")
+    p.add_argument("--damping", type=float, default=0.5, help="Cundall local damping α (the solver setting `damping`; range in its declaration)")
     p.add_argument("--tol", type=float, default=1e-3,
                    help="stop when line stresses change < tol·20 MPa over one check interval")
     p.add_argument("--max-time", type=float, default=None,
@@ -86,8 +86,7 @@ def check_args(a):
         raise ValueError(f"--ppc = {a.ppc} must be in [1, 4]")
     if a.boundary_load == "consistent":
         ym.consistent_row_weights(a.ppc)              # raises for ppc = 1
-    if not 0 <= a.damping < 1:
-        raise ValueError(f"--damping = {a.damping} must be in [0, 1)")
+    ym.check_setting("damping", a.damping, "--damping")  # the solver's declared range
     if not (math.isfinite(a.tol) and a.tol > 0):
         raise ValueError(f"--tol = {a.tol} must be > 0")
     if a.max_time is not None and not (math.isfinite(a.max_time) and a.max_time > 0):

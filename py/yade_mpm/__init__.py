@@ -13,7 +13,7 @@ _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
 from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D
 from .materials import ElasticMat, DpGkMat
-from .scene import (make_solver, add_region, views, get, id_order, set_initial_stress, boundary_particles, apply_traction,
+from .scene import (check_setting, make_solver, add_region, views, get, id_order, set_initial_stress, boundary_particles, apply_traction,
                     apply_face_traction, consistent_row_weights, SYM_NAMES)
 from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
@@ -24,6 +24,6 @@ from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene buil
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
-           "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
+           "check_setting", "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
            "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "CONTACT_DEFAULTS", "DemSpheres",
            "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D"]

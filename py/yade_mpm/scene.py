@@ -19,6 +19,20 @@ def make_solver(lo, hi, spacing, margin=2):
     return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells))
 
 
+def check_setting(name, value, option=None):
+    """Checks a solver setting (declared once in pkg-mpm/SolverSettings.hpp) before any solver exists,
+    e.g. a command-line option; the ValueError names `option` (default: the setting) with the declared
+    unit and range. Returns the value."""
+    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+    if name not in probe.settings():
+        raise ValueError(f"unknown solver setting '{name}'; known: {', '.join(probe.settings())}")
+    try:
+        setattr(probe, name, value)
+    except ValueError as e:
+        raise ValueError(str(e).replace(f"Solver2D.{name}", option or name)) from None
+    return value
+
+
 def dim_of(solver):
     """2 or 3; ValueError if `solver` is not a Solver2D/Solver3D."""
     if isinstance(solver, _core.Solver2D):
