@@ -114,9 +114,9 @@ class CaseRun:
         self.state = dict(curve=[], acc=[0.0, 0], first_crack=None, wall=0.0, steps_run=0, done=False, snapshots=[])
 
     def _rock_mask(self):
-        if self.case != "grout_flaw":
-            return np.ones(self.solver.numParticles, bool)
-        return ~self.bodies["flaw"]["polygon"].contains(self.x0)
+        """Per particle (id order): rock, not grout (the rock is material 0 of the scene)."""
+        s = self.solver
+        return s.view("material")[ym.id_order(s)] == 0
 
     # ---- recorders
     def displacement(self):
@@ -178,6 +178,13 @@ class CaseRun:
         a, s = self.args, self.solver
         from yade import O
         resumed = False
+        done = os.path.join(self.dir, "state.json")
+        if a.resume and os.path.exists(done):                 # a finished run: outputs again without the checkpoint
+            st = json.load(open(done))
+            if st.get("done") and st.get("time", 0) >= a.end_time * (1 - runner.TIME_TOL):
+                self.state = st
+                print(f"[{self.case}] finished earlier (t = {st['time'] * 1e3:.3f} ms): outputs from its snapshots", flush=True)
+                return self
         if a.resume and os.path.exists(self.ckpt):
             h = checkpoint.load(self.ckpt, meta=self.meta)
             self.state = h["extra"]
@@ -219,7 +226,10 @@ class CaseRun:
             return self
         self.state["done"] = res.reason == "end_time"
         self.state["final_displacement"] = self.displacement()
+        self.state["time"] = s.time
         ck.save(s.steps)                                      # the last state: resumable, or the finished run
+        with open(done, "w") as f:                            # the recorded state, readable without the build
+            json.dump(self.state, f)
         if not self.state["done"]:
             print(f"[{self.case}] stopped at t = {s.time * 1e3:.3f} ms ({ck.signal_name or res.reason}); "
                   f"rerun with --resume to continue", flush=True)
@@ -233,9 +243,10 @@ class CaseRun:
         from matplotlib.patches import Polygon as Patch
         fig, ax = plt.subplots(figsize=(4.6, 4.8))
         x = self.x0 * 1e3
-        ax.scatter(x[self.rock, 0], x[self.rock, 1], s=0.3, c="tan", marker="s", linewidths=0, label="sandstone")
+        ms = (4.2 * 72 / 156 * self.dp * 1e3) ** 2          # a marker slightly wider than the particle cell
+        ax.scatter(x[self.rock, 0], x[self.rock, 1], s=ms, c="tan", marker="s", linewidths=0, label="sandstone", rasterized=True)
         if (~self.rock).any():
-            ax.scatter(x[~self.rock, 0], x[~self.rock, 1], s=0.3, c="tab:green", marker="s", linewidths=0, label="grout")
+            ax.scatter(x[~self.rock, 0], x[~self.rock, 1], s=ms, c="tab:green", marker="s", linewidths=0, label="grout", rasterized=True)
         for bid, color, name in ((self.bodies["platen"], "tab:blue", "rigid platen"), (self.bodies["filler"], "tab:red", "rigid filler")):
             if bid is None:
                 continue
@@ -252,7 +263,7 @@ class CaseRun:
         ax.set_xlim(-3, 153), ax.set_ylim(-3, 163)
         ax.set_xlabel("x [mm]"), ax.set_ylabel("y [mm]")
         ax.set_title(f"{self.case}: {self.solver.numParticles} particles, l = {self.solver.spacing * 1e3:g} mm", fontsize=9)
-        ax.legend(fontsize=7, loc="lower left", markerscale=10)
+        ax.legend(fontsize=7, loc="lower left", markerscale=3)
         fig.tight_layout()
         fig.savefig(os.path.join(self.dir, "geometry.png"), dpi=110)
         plt.close(fig)
