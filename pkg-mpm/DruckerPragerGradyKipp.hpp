@@ -7,6 +7,19 @@
 
 namespace mpm {
 
+// V of Eq. 37. The paper: "the volume of the material particle"; plane strain leaves the thickness open.
+enum class ThresholdVolume : int {
+	Particle     = 0, // the particle volume vol0 (2D: area × 1 m, the code's per-unit-thickness convention; literal)
+	SpacingCubed = 1, // dp³, dp = vol0^(1/D) the particle spacing (a particle as a cube of its own size)
+	CellSpacing  = 2  // l²·dp, l the grid spacing (2D: cell area × particle spacing)
+};
+
+// ε̄ of Eq. 36.
+enum class DamageStrain : int {
+	PrintedEq36      = 0, // σ̃max/(K + 4G/3): the uniaxial-strain value of the maximum principal stress (as printed)
+	PrincipalStrain  = 1  // ((1 + ν)σ1 − ν tr σ)/E: the true maximum principal elastic strain of the state stress
+};
+
 enum class DamageGrowthLaw : int {
 	BenzAsphaug = 0, // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{m/3}: Grady–Kipp / Benz–Asphaug (default)
 	AsPrinted   = 1  // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{1/3}: Eq. 38 exactly as printed
@@ -42,28 +55,81 @@ struct DpGkMat : ElasticMat {
 		const Real m = weibullM;
 		return 8 * M_PI * weibullK * (m + 3) * (m + 3) / ((m + 1) * (m + 2));
 	}
-	// Eq. 37: ε_D⁰ = (V k)^(−1/m). V is the particle volume; in plane strain, area × 1 m.
+	// Eq. 37: ε_D⁰ = (V k)^(−1/m) for a given V [m³].
 	Real activationStrain(Real volume) const { return std::pow(volume * weibullK, -1.0 / weibullM); }
-	// Eq. 37, refused outside (0, 1): V·k ≤ 1 (less than one flaw per particle) gives ε_D⁰ ≥ 1 and damage
-	// that can never start; an underflow to 0 would damage every particle at once.
-	Real threshold(Real volume) const
+	// V of Eq. 37 for a particle of initial volume vol0 [m³] (2D: area × 1 m) on a grid of spacing l [m].
+	Real thresholdVolumeOf(Real vol0, Real l, int dim) const
 	{
-		const Real e = activationStrain(volume);
-		if (!(e > 0 && e < 1))
-			throw InputError("damage threshold eps0 = (V·weibullK)^(−1/weibullM) = " + ParamInfo::num(e) + " for particle volume V = " + ParamInfo::num(volume)
-			                 + " m³ is outside the allowed range (0, 1) (weibullK = " + ParamInfo::num(weibullK) + " m^-3, weibullM = " + ParamInfo::num(weibullM)
-			                 + "; V·weibullK = " + ParamInfo::num(volume * weibullK) + " must exceed 1: at least one flaw per particle)");
+		const Real dp = std::pow(vol0, 1.0 / dim); // particle spacing
+		switch (ThresholdVolume(thresholdVolume)) {
+			case ThresholdVolume::Particle: return vol0;
+			case ThresholdVolume::SpacingCubed: return dp * dp * dp;
+			default: return l * l * dp;
+		}
+	}
+	// The particle's threshold scale ε_D⁰ (Eq. 37 with the V reading) on a grid of spacing l; with
+	// thresholdCell = l_ref > 0 the value of the l_ref grid (same ppc) scaled by √(l_ref/l), so that the
+	// effective toughness ε_D⁰ √l (and the energy per crack area of a one-cell crack band) is grid-independent.
+	Real thresholdScale(Real vol0, Real l, int dim) const
+	{
+		if (thresholdCell <= 0) return activationStrain(thresholdVolumeOf(vol0, l, dim));
+		const Real r = thresholdCell / l;
+		return activationStrain(thresholdVolumeOf(vol0 * std::pow(r, dim), thresholdCell, dim)) * std::sqrt(r);
+	}
+	// The particle's ε_D⁰, refused outside (0, 1): V·k ≤ 1 (less than one flaw per particle) gives ε_D⁰ ≥ 1
+	// and damage that can never start; an underflow to 0 would damage every particle at once.
+	Real threshold(Real vol0, Real l, int dim) const
+	{
+		const Real e = thresholdScale(vol0, l, dim);
+		if (!(e > 0 && e < 1)) {
+			const Real V = thresholdVolumeOf(vol0, l, dim);
+			throw InputError("damage threshold eps0 = (V·weibullK)^(−1/weibullM) = " + ParamInfo::num(e) + " for V = " + ParamInfo::num(V)
+			                 + " m³ (particle volume " + ParamInfo::num(vol0) + " m³, thresholdVolume = " + std::to_string(thresholdVolume)
+			                 + ") is outside the allowed range (0, 1) (weibullK = " + ParamInfo::num(weibullK) + " m^-3, weibullM = " + ParamInfo::num(weibullM)
+			                 + "; V·weibullK = " + ParamInfo::num(V * weibullK) + " must exceed 1: at least one flaw per particle)");
+		}
 		return e;
 	}
-	void checkThresholds(const Real* volume, size_t n) const
+	void checkThresholds(const Real* vol0, size_t n, Real l, int dim) const
 	{
 		for (size_t p = 0; p < n && damage; ++p)
-			if (volume[p] > 0 && volume[p] < INFINITY) threshold(volume[p]); // bad volumes are reported as such elsewhere
+			if (vol0[p] > 0 && vol0[p] < INFINITY) threshold(vol0[p], l, dim); // bad volumes are reported as such elsewhere
 	}
 };
 
 // The parameter tables add no runtime state: hot loops copy and read plain structs.
 static_assert(std::is_trivially_copyable_v<ElasticMat> && std::is_trivially_copyable_v<DpGkMat>, "material parameters must stay plain data");
+
+// Benz–Asphaug flaw population (Benz & Asphaug 1995): the flaw thresholds of a particle are the points
+// of a Poisson process in Λ = k V ε^m (so the expected number of flaws activated at strain ε is k V ε^m,
+// Eq. 37's Weibull law), i.e. ε_j = ε_D⁰ Λ_j^(1/m) with Λ_j = E_1 + … + E_j, E_i ~ Exp(1). E_i comes from
+// a counter-based hash of (seed, particle id, i): no stored stream, independent of threads and order.
+inline uint64_t splitmix64(uint64_t x)
+{
+	x += 0x9E3779B97F4A7C15ull;
+	x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+	x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+	return x ^ (x >> 31);
+}
+inline Real flawExp(int seed, int64_t id, int i)
+{
+	const uint64_t h = splitmix64(splitmix64(splitmix64(uint64_t(seed)) ^ uint64_t(id)) ^ uint64_t(i));
+	const Real     u = (Real(h >> 11) + 0.5) * (1.0 / 9007199254740992.0); // (0, 1)
+	return -std::log(u);
+}
+// Threshold of flaw j = 1, 2, … of particle id: ε_j = scale · (E_1 + … + E_j)^(1/m).
+inline Real flawThreshold(const DpGkMat& m, Real scale, int64_t id, int j)
+{
+	Real L = 0;
+	for (int i = 1; i <= j; ++i) L += flawExp(m.flawSeed, id, i);
+	return scale * std::pow(L, 1.0 / m.weibullM);
+}
+// ε_D⁰ a particle starts with (checked in (0, 1)): Eq. 37 with the V reading, or its first flaw's threshold.
+inline Real initialThreshold(const DpGkMat& m, Real vol0, Real l, int dim, int64_t id)
+{
+	const Real scale = m.threshold(vol0, l, dim);
+	return m.flawCount > 0 ? flawThreshold(m, scale, id, 1) : scale;
+}
 
 // Result of a single DP return, exposed for the single-particle tests.
 struct ReturnInfo {
@@ -75,10 +141,13 @@ template <int D>
 struct DruckerPragerGradyKipp {
 	static constexpr bool hasDamage = true;
 	DpGkMat mat;
-	Real    K, G, M, qphi, kphi, qpsi, cFloor, epsFloor, H, alpha13, cg;
+	Real    K, G, M, qphi, kphi, qpsi, cFloor, epsFloor, H, alpha13, cg, E, nu;
+	Real    cell; // grid spacing l [m] (threshold readings that depend on it)
 
-	explicit DruckerPragerGradyKipp(const DpGkMat& m) : mat(m)
+	explicit DruckerPragerGradyKipp(const DpGkMat& m, Real gridSpacing = 0) : mat(m), cell(gridSpacing)
 	{
+		E        = m.young;
+		nu       = m.poisson;
 		K        = m.bulk();
 		G        = m.shear();
 		M        = m.pWaveModulus();
@@ -135,18 +204,49 @@ struct DruckerPragerGradyKipp {
 		return r;
 	}
 
-	// GK damage growth (Eqs. 35–39) from the undamaged stress; D is non-decreasing and ≤ 1.
-	void damageGrowth(const Sym<D>& s, Real& Dmg, Real eps0, Real dt) const
+	// Threshold of a particle's first flaw: Eq. 37 (deterministic) or the first of its Weibull flaws.
+	Real initialThreshold(Real vol0, int64_t id) const { return mpm::initialThreshold(mat, vol0, cell, D, id); }
+
+	// ε̄ of Eq. 36 from the undamaged state stress (smax = its maximum principal value).
+	Real damageStrain(const Sym<D>& s, Real smax) const
+	{
+		if (mat.damageStrain == int(DamageStrain::PrintedEq36)) return smax / M;
+		return ((1 + nu) * smax - nu * (s.c[0] + s.c[1] + s.c[2])) / E; // max principal elastic strain
+	}
+
+	// GK damage growth (Eqs. 35–39) from the undamaged stress; D is non-decreasing and ≤ 1. Only under
+	// tension (σ̃max > 0). With a flaw population (nFlaw != nullptr: activated flaws so far) the flaws
+	// whose thresholds ε̄ has passed are activated and D is capped by their fraction (Benz & Asphaug 1995).
+	void damageGrowth(const Sym<D>& s, Real& Dmg, Real eps0, Real dt, Real* nFlaw = nullptr, Real vol0 = 0, int64_t id = 0) const
 	{
 		if (Dmg >= 1) return;
 		const Real smax = maxPrincipal(s);
 		if (smax <= 0) return;
-		const Real eb = smax / M; // Eq. 36
-		if (eb <= eps0) return;   // Eq. 35
+		const Real eb = damageStrain(s, smax); // Eq. 36
+		if (eb <= eps0) return;                // Eq. 35
+		Real cap = 1;
+		if (nFlaw) {
+			const int N = mat.flawCount;
+			int       n = int(*nFlaw);
+			if (n < N) {
+				const Real scale = mat.thresholdScale(vol0, cell, D);
+				Real       L     = 0;
+				for (int i = 1; i <= n; ++i) L += flawExp(mat.flawSeed, id, i);
+				while (n < N) {
+					const Real Ln = L + flawExp(mat.flawSeed, id, n + 1);
+					if (eb <= scale * std::pow(Ln, 1.0 / mat.weibullM)) break;
+					L = Ln, ++n;
+				}
+				*nFlaw = n;
+			}
+			if (n == 0) return; // eps0 edited above the first flaw's threshold
+			cap = Real(n) / N;
+		}
 		const Real m    = mat.weibullM;
 		const Real rate = cg * alpha13 / 3 * (mat.growthLaw == 0 ? std::pow(eb, m / 3) : std::cbrt(eb)); // Eq. 38
 		const Real d13  = std::cbrt(Dmg) + rate * dt;
 		Dmg             = d13 >= 1 ? 1.0 : d13 * d13 * d13;
+		if (Dmg > cap) Dmg = cap;
 	}
 
 	// Eq. 40: tensile principal stresses scaled by (1 − D), rotated back; compression unchanged.
@@ -160,11 +260,30 @@ struct DruckerPragerGradyKipp {
 		return pr.rebuild(v);
 	}
 
-	void update(Particles<D>& P, size_t p, Sym<D>& s, const Sym<D>& de, Real dt) const
+	// One material point: elastic trial → DP return → GK damage. A fully damaged particle (D = 1) is a
+	// tensile crack: its state keeps no tensile principal stress (Sec. 2.4.2, "a zero-stress state" in
+	// tension) before and after the DP return, so an opening crack neither stores tension nor yields;
+	// compression (a closed crack) is carried and may yield like rock. ε̄p is thus plastic strain of rock.
+	ReturnInfo updatePoint(Sym<D>& s, const Sym<D>& de, Real& epsP, Real& Dmg, Real eps0, Real dt, Real* nFlaw = nullptr, Real vol0 = 0,
+	                       int64_t id = 0) const
 	{
 		elasticTrial(s, de, K, G); // Eqs. 27–29
-		if (mat.plasticity) plasticReturn(s, P.epsP[p]);
-		if (mat.damage) damageGrowth(s, P.damage[p], P.eps0[p], dt);
+		const bool cracked = mat.damage && Dmg >= 1;
+		if (cracked) s = damaged(s, 1);
+		ReturnInfo r;
+		if (mat.plasticity) r = plasticReturn(s, epsP); // Eqs. 30–34
+		if (cracked) s = damaged(s, 1);                  // an apex return may land in tension
+		else if (mat.damage) damageGrowth(s, Dmg, eps0, dt, nFlaw, vol0, id); // Eqs. 35–39
+		return r;
+	}
+	void update(Particles<D>& P, size_t p, Sym<D>& s, const Sym<D>& de, Real dt) const
+	{
+		if (!mat.damage) {
+			elasticTrial(s, de, K, G);
+			if (mat.plasticity) plasticReturn(s, P.epsP[p]);
+			return;
+		}
+		updatePoint(s, de, P.epsP[p], P.damage[p], P.eps0[p], dt, mat.flawCount > 0 ? &P.nFlaw[p] : nullptr, P.vol0[p], P.id[p]);
 	}
 	Sym<D> forceStress(const Particles<D>& P, size_t p) const { return damaged(P.stress(p), P.damage[p]); }
 };

@@ -29,4 +29,18 @@
 	X(Real, weibullM, MPM_REQUIRED, "-", 1, 50, CC, "m", "Weibull modulus", "Eqs. 37–39", "damage")                              \
 	X(Real, crackSpeed, 0, "m/s", 0, INFINITY, CO, "c_g", "crack growth speed; 0 = 0.4 × P-wave speed", "Eq. 38", "damage")     \
 	X(int, growthLaw, 0, "-", 0, 1, CC, "",                                                                                      \
-	  "damage growth law: 0 = Grady–Kipp/Benz–Asphaug dD^⅓/dt ∝ ε̄^(m/3), 1 = Eq. 38 as printed ∝ ε̄^(1/3)", "Eq. 38", "damage")
+	  "damage growth law: 0 = Grady–Kipp/Benz–Asphaug dD^⅓/dt ∝ ε̄^(m/3), 1 = Eq. 38 as printed ∝ ε̄^(1/3)", "Eq. 38", "damage") \
+	X(int, thresholdVolume, 1, "-", 0, 2, CC, "V",                                                                               \
+	  "V of Eq. 37 in m³: 0 = particle volume (2D: area × 1 m, literal), 1 = dp³ (particle spacing cubed), 2 = l²·dp "            \
+	  "(grid spacing² × particle spacing); see doc/damage_growth_law.md", "Eq. 37", "damage")                                   \
+	X(int, damageStrain, 0, "-", 0, 1, CC, "ε̄",                                                                                 \
+	  "tensile strain of Eq. 36: 0 = σ̃max/(K + 4G/3) as printed, 1 = maximum principal elastic strain of the state stress",     \
+	  "Eqs. 35–36", "damage")                                                                                                    \
+	X(Real, thresholdCell, 0, "m", 0, INFINITY, CO, "l_ref",                                                                     \
+	  "regularised threshold: ε_D⁰ of the l_ref grid scaled by √(l_ref/l), same effective toughness on every grid; 0 = off",   \
+	  "Eq. 37", "damage")                                                                                                        \
+	X(int, flawCount, 0, "-", 0, 1000, CC, "",                                                                                   \
+	  "Benz–Asphaug flaws per particle (Weibull thresholds from k, m; D ≤ activated fraction); 0 = one threshold (Eq. 37)",    \
+	  "Eqs. 37–38", "damage")                                                                                                    \
+	X(int, flawSeed, 0, "-", 0, 2147483647, CC, "", "seed of the flaw population (thresholds depend on seed and particle id)",  \
+	  "Eq. 37", "damage")

@@ -80,7 +80,7 @@ public:
 	{
 		if (!single()) return f(mixed);
 		if (list[0].kind == MaterialKind::Elastic) f(LinearElastic<D>(list[0].elastic));
-		else f(DruckerPragerGradyKipp<D>(list[0].dpgk));
+		else f(DruckerPragerGradyKipp<D>(list[0].dpgk, cell));
 	}
 	// v_c from the minimum of dtDensity (see above) [m/s].
 	Real waveSpeed(Real minDtDensity) const { return std::sqrt((single() ? list[0].elastic.pWaveModulus() : 1.0) / minDtDensity); }
@@ -93,17 +93,27 @@ public:
 		return r;
 	}
 	const Entry& of(const Particles<D>& P, size_t p) const { return list[P.mat[p]]; }
-	// Eq. 37 thresholds ε_D⁰ for particles [from, n) whose material is DP–GK with damage on.
+	// Eq. 37 thresholds ε_D⁰ (with a flaw population: of the first flaw) for particles [from, n) whose
+	// material is DP–GK with damage on; allocates the activated-flaw counts when a material has flaws.
 	void initDamageThresholds(Particles<D>& P, size_t from) const
 	{
+		for (const auto& e : list)
+			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage && e.dpgk.flawCount > 0 && P.nFlaw.size() != P.n) P.nFlaw.assign(P.n, 0.0);
 		for (size_t p = from; p < P.n; ++p) {
 			const Entry& e = of(P, p);
-			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage) P.eps0[p] = e.dpgk.threshold(P.vol0[p]);
+			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage) P.eps0[p] = initialThreshold(e.dpgk, P.vol0[p], cell, D, P.id[p]);
 		}
+	}
+	// Grid spacing l [m]: the V readings and the regularised threshold of Eq. 37 depend on it.
+	void setCell(Real l)
+	{
+		cell = l;
+		rebuild();
 	}
 
 private:
 	std::vector<Entry> list;
+	Real               cell = 0; // grid spacing l [m]
 	MixedMaterial<D>   mixed; // kernels of a mixed scene, rebuilt when the list changes (never while stepping)
 
 	size_t push(const Entry& e)
@@ -121,7 +131,7 @@ private:
 			mixed.kind[i]      = uint8_t(e.kind);
 			mixed.modulus[i]   = e.elastic.pWaveModulus();
 			if (e.kind == MaterialKind::Elastic) mixed.slot[i] = uint8_t(mixed.el.size()), mixed.el.emplace_back(e.elastic);
-			else mixed.slot[i] = uint8_t(mixed.dp.size()), mixed.dp.emplace_back(e.dpgk);
+			else mixed.slot[i] = uint8_t(mixed.dp.size()), mixed.dp.emplace_back(e.dpgk, cell);
 		}
 	}
 };

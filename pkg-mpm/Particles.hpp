@@ -25,7 +25,8 @@ struct Particles {
 	std::vector<Real> trac[D]; // prescribed surface force on the particle (traction × area) [N]
 	std::vector<Real> epsP;    // accumulated plastic strain ε̄p [-]
 	std::vector<Real> damage;  // Grady–Kipp damage D [-]
-	std::vector<Real> eps0;    // Grady–Kipp activation strain ε_D⁰, Eq. 37 [-]
+	std::vector<Real> eps0;    // Grady–Kipp activation strain ε_D⁰, Eq. 37 (with flaws: of the first flaw) [-]
+	std::vector<Real> nFlaw;   // activated Benz–Asphaug flaws (only with a flaw population) [-]
 
 	bool hasTraction() const { return !trac[0].empty(); }
 	bool hasDamageState() const { return !damage.empty(); }
@@ -54,6 +55,7 @@ struct Particles {
 		for (int a = 0; a < D; ++a)
 			if (!trac[a].empty()) f(trac[a]);
 		if (!epsP.empty()) f(epsP), f(damage), f(eps0);
+		if (!nFlaw.empty()) f(nFlaw);
 	}
 
 	// Appends n particles (positions x[p·D + a] [m], volumes [m³], masses [kg]) after checking every value;

@@ -41,7 +41,7 @@ public:
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
 
-	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { }
+	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { materials.setCell(grid.spacing); }
 	Solver(const Solver&)            = delete; // xfer refers to the members
 	Solver& operator=(const Solver&) = delete;
 
@@ -52,7 +52,7 @@ public:
 		materials.checkIndex(material);
 		const size_t old = P.n;
 		if (materials.size() && materials[size_t(material)].kind == MaterialKind::DruckerPragerGradyKipp)
-			materials[size_t(material)].dpgk.checkThresholds(vol, n); // ε_D⁰ ∈ (0, 1) before anything is added
+			materials[size_t(material)].dpgk.checkThresholds(vol, n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything is added
 		P.append(x, vol, mass, n, grid.origin, grid.upper(), uint8_t(material));
 		if (materials.anyDpgk()) {
 			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
@@ -79,7 +79,7 @@ public:
 			throw InputError("setMaterial: this solver holds " + std::to_string(materials.size())
 			                 + " materials; setMaterial replaces the only material of a one-material scene — use addMaterial and addParticles(…, material=index)");
 		m.validate();
-		if constexpr (std::is_same_v<Mat, DpGkMat>) m.checkThresholds(P.vol0.data(), P.n); // ε_D⁰ ∈ (0, 1) before anything changes
+		if constexpr (std::is_same_v<Mat, DpGkMat>) m.checkThresholds(P.vol0.data(), P.n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything changes
 		if constexpr (std::is_same_v<Mat, DpGkMat>) materials.replaceFirst({ MaterialKind::DruckerPragerGradyKipp, ElasticMat(m), m });
 		else materials.replaceFirst({ MaterialKind::Elastic, m, DpGkMat {} });
 		if (materials.anyDpgk() && P.n) P.ensureDamageState(), materials.initDamageThresholds(P, 0);

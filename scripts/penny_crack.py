@@ -39,9 +39,17 @@ PAPER_CELL = 0.02                      # m
 SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
 
 
-def build(size, h, material, P, ramp, damping, crack_nodes="shared"):
-    """The cracked block (yade_mpm.cases.line_crack); returns (solver, crack geometry dict)."""
-    return cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK)
+def build(size, h, material, P, ramp, damping, crack_nodes="shared", edges="free", edge_set="topbottom"):
+    """The cracked block (yade_mpm.cases.line_crack) with the outer boundary `edges` on `edge_set`;
+    returns (solver, crack geometry dict). Outer boundary: grid-node planes on the block faces (free =
+    none); "slip" zeroes the normal velocity, "fixed" every component; "topbottom" acts on the faces
+    y = 0, L only, "all" also on x = 0, L."""
+    s, geo = cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK)
+    if edges != "free":
+        for axis in ((1,) if edge_set == "topbottom" else (0, 1)):
+            s.addBoundaryPlane(axis, -1, 0.0, edges)
+            s.addBoundaryPlane(axis, 1, size, edges)
+    return s, geo
 
 
 def face_opening(s, geo):
@@ -58,7 +66,8 @@ def run_elastic(size, h, P, args):
     mat = rocks.granite()
     cp = math.sqrt((mat.young * (1 - mat.poisson) / ((1 + mat.poisson) * (1 - 2 * mat.poisson))) / mat.density)
     transit = size / cp
-    s, geo = build(size, h, mat, P, ramp=2 * transit, damping=args.elastic_damping, crack_nodes=args.crack_nodes)
+    s, geo = build(size, h, mat, P, ramp=2 * transit, damping=args.elastic_damping, crack_nodes=args.crack_nodes,
+                   edges=args.edges, edge_set=args.edge_set)
     t0 = time.time()
     ref = sneddon.opening_displacement(0.0, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
     hist = []
@@ -137,15 +146,26 @@ def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
     plt.close(fig)
 
 
+THRESHOLD_VOLUMES = {"area": 0, "cube": 1, "l2dp": 2}   # DpGkMat.thresholdVolume (V of Eq. 37)
+DAMAGE_STRAINS = {"eq36": 0, "principal": 1}             # DpGkMat.damageStrain (ε̄ of Eq. 36)
+
+
+def damage_options(args, law):
+    """DpGkMat keyword overrides of the damage run selected on the command line."""
+    kw = dict(growthLaw=law, damageStrain=DAMAGE_STRAINS[args.damage_strain], thresholdCell=args.threshold_cell,
+              flawCount=args.flaws, flawSeed=args.flaw_seed)
+    if args.threshold_volume is not None:
+        kw["thresholdVolume"] = THRESHOLD_VOLUMES[args.threshold_volume]
+    return kw
+
+
 def run_damage(args, law, outdir):
     size, h = args.size, args.damage_spacing
     ramp = PAPER_RAMP if args.full else args.ramp_time
     scale = PAPER_RAMP / ramp                                  # t_paper = scale · t
-    mat = rocks.granite_dpgk(growthLaw=law)
-    s, geo = build(size, h, mat, args.damage_pressure, ramp=ramp, damping=args.damage_damping, crack_nodes=args.crack_nodes)
-    if args.threshold_volume == "cube":
-        # sensitivity study: Eq. 37 with V = (particle spacing)³ instead of area × 1 m
-        s.view("eps0")[:] = mat.activationStrain(geo["dp"] ** 3)
+    mat = rocks.granite_dpgk(**damage_options(args, law))
+    s, geo = build(size, h, mat, args.damage_pressure, ramp=ramp, damping=args.damage_damping, crack_nodes=args.crack_nodes,
+                   edges=args.edges, edge_set=args.edge_set)
     t_end = args.end_time / scale
     rec_dt = args.record_every / scale
     rows = []
@@ -176,12 +196,25 @@ def run_damage(args, law, outdir):
               "plastic_particles", "wall_s"]
     out.write_csv(os.path.join(outdir, f"crack_extension_law{law}.csv"), header, rows)
     plastic = int(np.count_nonzero(s.view("epsP") > 0))
-    # yielded particles that are not tensile cracks: plasticity of intact rock (a fully damaged particle's
-    # undamaged state stress keeps growing with the opening and can reach the DP apex; that is not rock yielding)
+    # ε̄p is plastic strain of rock (a fully damaged particle keeps no tension, so an opening crack does not
+    # yield); the second count says how many of the yielded particles are not (yet) fully cracked
     plastic_intact = int(np.count_nonzero((s.view("epsP") > 0) & (s.view("damage") < 1)))
     return dict(law=law, rows=rows, wall=wall, particles=s.numParticles, steps=s.steps, plastic=plastic,
                 plastic_intact=plastic_intact,
                 ramp=ramp, scale=scale, h=h, size=size)
+
+
+def paper_comparison(rows, h):
+    """Δa in cells of the paper's grid (0.02 m) at the paper's times, its deviations from Fig. 9 (RMS and
+    largest, cells), and the initiation time (first record with Δa ≥ 1 cell of this grid at either tip)."""
+    cells = h / PAPER_CELL
+    da = [0.5 * sum(interp_da(rows, t)) * cells for t, _ in PAPER_DA]
+    dev = [d - n for d, (_, n) in zip(da, PAPER_DA)]
+    init = next((r[0] for r in rows if max(r[2], r[3]) >= 1), None)
+    return dict(da_paper_cells=da, deviation_cells=dev, rms_deviation_cells=math.sqrt(sum(x * x for x in dev) / len(dev)),
+                max_abs_deviation_cells=max(abs(x) for x in dev), initiation_t_paper_s=init,
+                symmetric=all(abs(r[2] - r[3]) <= 1 for r in rows),
+                monotonic=all(b[2] >= a[2] and b[3] >= a[3] for a, b in zip(rows, rows[1:])))
 
 
 def interp_da(rows, t):
@@ -268,10 +301,22 @@ def main(argv=None):
     ap.add_argument("--end-time", type=float, default=0.4, help="end of the damage run on the paper time axis [s]")
     ap.add_argument("--record-every", type=float, default=0.005, help="Δa record interval on the paper time axis [s]")
     ap.add_argument("--laws", default="0,1", help="damage growth laws to run: 0 = ε̄^(m/3) (default law), 1 = Eq. 38 as printed")
-    ap.add_argument("--threshold-volume", choices=("area", "cube"), default="area",
-                    help="V of Eq. 37: area × 1 m (plane strain, default) or (particle spacing)³ (sensitivity study)")
+    ap.add_argument("--threshold-volume", choices=tuple(THRESHOLD_VOLUMES), default=None,
+                    help="V of Eq. 37 (DpGkMat.thresholdVolume): area = particle area × 1 m (literal), cube = dp³, "
+                         "l2dp = l²·dp; default: the material's default (dp³, doc/damage_growth_law.md)")
+    ap.add_argument("--damage-strain", choices=tuple(DAMAGE_STRAINS), default="eq36",
+                    help="ε̄ of Eq. 36 (DpGkMat.damageStrain): eq36 = σ̃max/(K + 4G/3) as printed, principal = max principal strain")
+    ap.add_argument("--threshold-cell", type=float, default=0.0,
+                    help="regularised threshold: ε_D⁰ of a grid of this spacing [m] scaled by √(l_ref/l) (DpGkMat.thresholdCell); 0 = off")
+    ap.add_argument("--flaws", type=int, default=0, help="Benz–Asphaug flaws per particle (DpGkMat.flawCount); 0 = one threshold")
+    ap.add_argument("--flaw-seed", type=int, default=0, help="seed of the flaw population (DpGkMat.flawSeed)")
     ap.add_argument("--crack-nodes", choices=("shared", "excluded"), default="shared",
                     help="grid nodes on the crack mid-line: shared by both faces (paper) or excluded from the WLS fits")
+    ap.add_argument("--edges", choices=("free", "slip", "fixed"), default="slip",
+                    help="outer boundary of the block: slip (normal velocity 0, default: a supported block, "
+                         "doc/penny_crack.md), fixed, or free (the figure's unsupported block)")
+    ap.add_argument("--edge-set", choices=("topbottom", "all"), default="topbottom",
+                    help="faces the --edges condition acts on: top and bottom (y = 0, L) or all four")
     ap.add_argument("--band", type=float, default=0.2, help="half height of the band around the crack line searched for D = 1 [m]")
     ap.add_argument("--full", action="store_true", help="paper configuration: 0.5 s ramp, l = 0.02 m elastic run (hours)")
     ap.add_argument("--vtu", action="store_true", help="also write VTU particle files of the damage snapshots")
@@ -294,7 +339,11 @@ def main(argv=None):
     summary = dict(config=dict(size_m=a.size, elastic_spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
                                ramp_time_s=PAPER_RAMP if a.full else a.ramp_time, paper_ramp_s=PAPER_RAMP,
                                full=a.full, elastic_damping=a.elastic_damping, damage_damping=a.damage_damping,
-                               threshold_volume=a.threshold_volume, crack_nodes=a.crack_nodes, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
+                               threshold_volume=next(k for k, v in THRESHOLD_VOLUMES.items()
+                                                     if v == rocks.granite_dpgk(**damage_options(a, 0)).thresholdVolume),
+                               damage_strain=a.damage_strain,
+                               threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes,
+                               edges=a.edges, edge_set=a.edge_set, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
                                threads=ym.getThreads()))
     wall0 = time.time()
     particles = 0
@@ -338,6 +387,8 @@ def main(argv=None):
                                                plastic_particles_not_cracked=r["plastic_intact"],
                                                wall_time_s=r["wall"], steps=r["steps"], ramp_time_s=r["ramp"],
                                                spacing_m=r["h"], particles=r["particles"])
+            if a.end_time >= PAPER_DA[-1][0] - 1e-9:
+                summary[f"damage_law{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
             print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
                   + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
         plot_da(results, a.out)
@@ -346,6 +397,8 @@ def main(argv=None):
         summary["crack_extension_cells"] = first["crack_extension_cells"]
         summary["plastic_particles"] = first["plastic_particles"]
         summary["plastic_particles_not_cracked"] = first["plastic_particles_not_cracked"]
+        if "paper_comparison" in first:
+            summary["paper_comparison"] = first["paper_comparison"]
         summary["paper_crack_extension_cells"] = [dict(t_s=t, cells=n) for t, n in PAPER_DA]
     summary["wall_time_s"] = time.time() - wall0
     summary["particles"] = particles

@@ -33,7 +33,7 @@ SCENE = textwrap.dedent("""
         s.addBoundaryPlane(1, -1, 0.0, "fixed")
         s.damping, s.sortPeriod = 0.05, 7
         s.view("v0")[:] = 40 * (s.view("x0") - 0.15)
-        s.view("v1")[:] = -40 * s.view("x1")
+        s.view("v1")[:] = -150 * s.view("x1")   # strong enough vertical squeeze that intact rock yields
         s.requestSort()
         O.bodies.append(utils.sphere((1, 1, 0), 0.1))
         O.bodies[0].state.vel = (0.3, 1.1, 0)

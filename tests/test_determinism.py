@@ -17,8 +17,8 @@ CHILD = r"""
 import json, math, sys
 import numpy as np
 import yade_mpm as ym
-dim, nsteps = int(sys.argv[1]), int(sys.argv[2])
-mat = ym.rocks.granite_dpgk()
+dim, nsteps, flaws = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+mat = ym.rocks.granite_dpgk(flawCount=flaws, flawSeed=3)   # flaws > 0: Benz–Asphaug population
 l = 0.01
 if dim == 2:
     hi = (0.6, 0.3)
@@ -57,20 +57,23 @@ print("RESULT " + json.dumps(out))
 """
 
 
-def _run(dim, steps, threads):
+def _run(dim, steps, threads, flaws=0):
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     env["PYTHONPATH"] = os.path.join(root, "py") + os.pathsep + env.get("PYTHONPATH", "")
-    r = subprocess.run([sys.executable, "-c", CHILD, str(dim), str(steps)], env=env, capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-c", CHILD, str(dim), str(steps), str(flaws)], env=env, capture_output=True, text=True,
                        timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
     line = [l for l in r.stdout.splitlines() if l.startswith("RESULT ")]
     return json.loads(line[-1][7:])
 
 
-@pytest.mark.parametrize("dim,steps", [(2, 120), (3, 40)])
-def test_one_and_two_threads_bitwise_identical(dim, steps):
-    one, two = _run(dim, steps, 1), _run(dim, steps, 2)
+@pytest.mark.parametrize("dim,steps,flaws", [(2, 120, 0), (3, 40, 0), (2, 120, 8)])
+def test_one_and_two_threads_bitwise_identical(dim, steps, flaws):
+    one, two = _run(dim, steps, 1, flaws), _run(dim, steps, 2, flaws)
+    if flaws:   # the flaw population is really used: partially damaged particles with some flaws active
+        nf = np.frombuffer(bytes.fromhex(one["nFlaw"]), dtype=np.float64)
+        assert np.any((nf > 0) & (nf < flaws)), "no particle with a partial flaw activation"
     # the scene must really exercise plasticity and damage, else the comparison proves little
     assert one["plastic"] > 0.05 and one["damaged"] > 0.01, (one["plastic"], one["damaged"])
     assert one.keys() == two.keys()

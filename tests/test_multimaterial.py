@@ -82,7 +82,7 @@ def test_regions_keep_their_own_material_and_damage_thresholds():
     # the rock keeps its parameters and its particles their Eq. 37 thresholds ε_D⁰ = (V k)^(−1/m)
     assert s.material(0).toDict() == rock.toDict()
     eps0 = s.view("eps0")[np.argsort(s.view("id"))]
-    v = (0.01 / 2) ** 2
+    v = (0.01 / 2) ** 3                                    # V = dp³ (default thresholdVolume = 1)
     assert np.allclose(eps0[ids_rock], (v * rock.weibullK) ** (-1 / rock.weibullM), rtol=1e-12)
     assert np.array_equal(eps0[ids_rock], eps0_before[ids_rock])
     assert np.all(eps0[ids_grout] == 0)

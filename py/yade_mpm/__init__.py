@@ -11,7 +11,8 @@ import os as _os
 # Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE); users may override.
 _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
-from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D
+from ._core import (Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D,
+                    dpgkFlawThresholds, dpgkThresholdScale)
 from .materials import ElasticMat, DpGkMat
 from .scene import (check_setting, make_solver, add_region, views, get, id_order, set_initial_stress, boundary_particles, apply_traction,
                     apply_face_traction, consistent_row_weights, SYM_NAMES)
@@ -26,4 +27,5 @@ from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
            "check_setting", "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
            "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "CONTACT_DEFAULTS", "DemSpheres",
-           "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D"]
+           "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
+           "dpgkThresholdScale"]

@@ -75,7 +75,7 @@ def _field_names(solver):
     d = dim_of(solver)
     return ([f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"C{k}" for k in range(d * d)]
             + ["mass", "vol", "vol0"] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
-            + [f"trac{a}" for a in range(d)] + ["epsP", "damage", "eps0"])
+            + [f"trac{a}" for a in range(d)] + ["epsP", "damage", "eps0", "nFlaw"])
 
 
 def _particle_arrays(solver):

@@ -73,7 +73,7 @@ def views(solver):
     changes when particles are re-sorted; `id` tells which particle sits in each slot."""
     d = dim_of(solver)
     names = [f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
-    names += ["mass", "vol", "vol0", "id", "material", "epsP", "damage", "eps0"]
+    names += ["mass", "vol", "vol0", "id", "material", "epsP", "damage", "eps0", "nFlaw"]
     out = {}
     for n in names:
         try:
