@@ -42,7 +42,7 @@ def main(argv=None):
     for spec in a.runs:
         if "=" not in spec:
             ap.error(f"run '{spec}' must be label=directory")
-        label, path = spec.split("=", 1)
+        label, path = spec.rsplit("=", 1)
         summ, rows, h = load(path, a.law)
         cells = h / pc.PAPER_CELL
         rl = [tuple(r) for r in rows]
