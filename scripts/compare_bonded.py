@@ -64,7 +64,9 @@ def parse_args(argv=None):
     p.add_argument("--calib-iters", type=int, default=4, help="maximum calibration runs")
     p.add_argument("--calib-ratios", type=float, nargs=2, default=[PILOT_E_RATIO, PILOT_PEAK_RATIO], metavar=("E_RATIO", "PEAK_RATIO"),
                    help="initial guess: E_app/young and peak/tensile of an earlier run (default: the pilot run's)")
-    p.add_argument("--max-strain", type=float, default=0.02, help="axial strain limit of a uniaxial run")
+    p.add_argument("--max-strain", type=float, default=0.02, help="axial strain limit of an MPM uniaxial run")
+    p.add_argument("--dem-max-strain", type=float, default=0.03,
+                   help="axial strain limit of a JCFpm uniaxial run (elastic-brittle: it stops after its peak)")
     p.add_argument("--kirsch-domain", type=float, default=1.2, help="side of the square block of the Kirsch test [m]")
     p.add_argument("--kirsch-mpm-spacing", type=float, default=0.02, help="finest MPM spacing [m] (runs: 2l, 1.5l, l)")
     p.add_argument("--kirsch-dem-radii", type=float, nargs="+", default=[0.02, 0.014, 0.01, 0.007],
@@ -77,7 +79,8 @@ def parse_args(argv=None):
     parts = set(a.parts.split(","))
     if not parts <= {"uniaxial", "kirsch", "mpm_intact", "mpm_open_flaw"}:
         raise ValueError(f"--parts = {a.parts}: allowed uniaxial, kirsch, mpm_intact, mpm_open_flaw")
-    for n in ("platen_speed", "mpm_spacing", "dem_radius", "calib_tol", "max_strain", "kirsch_domain", "kirsch_mpm_spacing"):
+    for n in ("platen_speed", "mpm_spacing", "dem_radius", "calib_tol", "max_strain", "dem_max_strain", "kirsch_domain",
+              "kirsch_mpm_spacing"):
         v = getattr(a, n)
         if not (math.isfinite(v) and v > 0):
             raise ValueError(f"--{n.replace('_', '-')} = {v} must be > 0")
@@ -103,6 +106,14 @@ SPECIMEN = (0.05, 0.15)                     # width × height [m] (paper Sec. 3.
 FLAW = dict(center=(0.025, 0.075), length=0.025, width=0.002, angle=math.radians(30.0))
 CAP_CELLS = 3                               # MPM end caps: no tensile damage within 3 cells of a platen
 DAMPING = 0.4                               # local (Cundall) damping on both sides: MPM solver.damping, YADE Newton
+
+
+RAMP_TIME = 1e-3                            # platen speed ramped linearly from 0 over this time [s] (both methods)
+
+
+def platen_velocity(t, a):
+    """Platen closing speed at time t [m/s]: linear ramp over RAMP_TIME (no start-up shock), then constant."""
+    return a.platen_speed * min(1.0, t / RAMP_TIME)
 
 
 def uniaxial_flaw():
@@ -145,12 +156,12 @@ def mpm_uniaxial(flaw, a):
     rb.add([bot, top], mu=0.0)
     O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmUniax", bodies=rb).runner(), NewtonIntegrator(damping=0.0)]
     O.dt = 1.0
-    O.bodies[top].state.vel = (0.0, -a.platen_speed, 0.0)
     label = "mpm " + ("open flaw" if flaw else "intact")
     prog = ym.Progress(a.max_strain, label, 20.0)
     strain, stress, peak = [0.0], [0.0], 0.0
     t0, c0 = time.time(), time.process_time()
     while True:
+        O.bodies[top].state.vel = (0.0, -platen_velocity(O.time, a), 0.0)
         O.run(100, True)
         strain.append((H - (O.bodies[top].state.pos[1] - O.bodies[bot].state.pos[1])) / H)
         stress.append(0.5 * (rb.force(top)[1] - rb.force(bot)[1]) / W)
@@ -173,9 +184,9 @@ def packing(a, lo, hi, r):
 
 
 def jcfpm_uniaxial(P, micro, holes, a, label):
-    prog = ym.Progress(a.max_strain, label, 20.0)
-    res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.max_strain, damping=DAMPING,
-                          crack_dir=os.path.join(a.out, "jcfpm_cracks"), label=label,
+    prog = ym.Progress(a.dem_max_strain, label, 20.0)
+    res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.dem_max_strain, damping=DAMPING,
+                          crack_dir=os.path.join(a.out, "jcfpm_cracks"), label=label, ramp_time=RAMP_TIME,
                           progress=lambda e, s: prog.update(0, e))
     res["youngs_modulus"] = bonded.apparent_modulus(res["strain"], res["stress"])
     res["peak_stress"] = float(np.max(res["stress"]))

@@ -67,7 +67,7 @@ def build(a):
     from yade.wrapper import FrictMat
     O.reset()
     L, H, l = a.length, a.height, a.spacing
-    s = ym.make_solver((0.0, 0.0), (L, H + 0.3), l)          # room above the slab for ejected particles
+    s = ym.make_solver((-0.3, 0.0), (L + 0.3, H + 0.3), l)   # room around the slab for ejected fragments
     ym.add_region(s, rocks.miao2018_sandstone(), (0.0, 0.0), (L, H), ppc=2)
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.gravity = (0.0, -9.81)

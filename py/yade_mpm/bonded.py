@@ -135,22 +135,26 @@ def layer_thickness(packing):
     return 2.0 * float(np.mean(packing[:, 2]))
 
 
-def apparent_modulus(strain, stress, lo=0.1, hi=0.5):
+def apparent_modulus(strain, stress, lo=0.25, hi=0.5):
     """Apparent (plane-strain) modulus [Pa] of a compression curve: least-squares slope of stress vs
-    strain over the pre-peak points with lo·peak ≤ stress ≤ hi·peak (skips the seating toe)."""
+    strain over the points with lo·peak ≤ stress of the first rise up to hi·peak (skips the seating toe
+    and the start-up transient of a platen set moving at once, and any dip and re-rise later)."""
     strain, stress = np.asarray(strain, float), np.asarray(stress, float)
     ip = int(np.argmax(stress))
-    s, e = stress[:ip + 1], strain[:ip + 1]
-    m = (s >= lo * stress[ip]) & (s <= hi * stress[ip])
+    # the first rise only: up to the first point above hi·peak (a later dip and re-rise is not elastic)
+    n = int(np.argmax(stress > hi * stress[ip]))
+    s, e = stress[:n], strain[:n]
+    m = s >= lo * stress[ip]
     if m.sum() < 3:
         raise ValueError(f"only {int(m.sum())} points between {lo} and {hi} of the peak: record the curve more densely")
     return float(np.polyfit(e[m], s[m], 1)[0])
 
 
 def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1.3, max_strain=0.015,
-             post_peak_drop=0.7, record_every=200, crack_dir=None, progress=None, label="jcfpm"):
+             post_peak_drop=0.7, record_every=200, crack_dir=None, progress=None, label="jcfpm", ramp_time=0.0):
     """Uniaxial compression of a JCFpm disc-layer specimen between two frictionless platens (YADE
-    walls; the top one moves down at platen_speed [m/s], the bottom one is fixed), run in O.
+    walls; the top one moves down at platen_speed [m/s], reached by a linear ramp over ramp_time [s],
+    the bottom one is fixed), run in O.
     Bonds: every pair closer than idf·(r1 + r2) at the first step (JCFpm convention), then idf = 1.
     Stops when the stress has stayed below post_peak_drop·peak for three records, or at max_strain.
     Returns dict(strain, stress [Pa] (compression +), particles, steps, wall_time_s, cpu_time_s, dt, bonds,
@@ -166,6 +170,8 @@ def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1
         raise ValueError(f"damping = {damping} must be in [0, 1)")
     if not 1 <= idf <= 2:
         raise ValueError(f"idf = {idf} must be in [1, 2]")
+    if not (math.isfinite(ramp_time) and ramp_time >= 0):
+        raise ValueError(f"ramp_time = {ramp_time} s must be ≥ 0")
     if not 0 < post_peak_drop < 1:
         raise ValueError(f"post_peak_drop = {post_peak_drop} must be in (0, 1)")
     yade, O, pack_, utils, w = _yade()
@@ -210,11 +216,12 @@ def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1
         O.step()
         bo1.aabbEnlargeFactor, ig2.interactionDetectionFactor = 1.0, 1.0
         bonds = sum(1 for i in O.interactions if isinstance(i.phys, w.JCFpmPhys) and i.phys.isCohesive)
-        O.bodies[top].state.vel = (0.0, -platen_speed, 0.0)
         area = width * t
         strain, stress = [0.0], [0.0]
         peak = 0.0
         while True:
+            ramp = min(1.0, O.time / ramp_time) if ramp_time > 0 else 1.0
+            O.bodies[top].state.vel = (0.0, -platen_speed * ramp, 0.0)
             O.run(record_every, True)
             gap = O.bodies[top].state.pos[1] - O.bodies[bot].state.pos[1]
             strain.append((height - gap) / height)
@@ -237,6 +244,10 @@ def uniaxial(packing, micro, platen_speed, density, holes=(), damping=0.4, idf=1
             ix, iy = head.index("p0"), head.index("p1")
             it = head.index("type") if "type" in head else head.index("t")
             cracks = data[:, [ix, iy, it]]
+            # the type code of a tensile break differs between YADE versions (2023.02: 1); take the code
+            # whose count is the law's tensile counter and store 0 = tensile, 1 = shear
+            tens = 1.0 if np.sum(cracks[:, 2] == 1) == law.nbTensCracks else 0.0
+            cracks[:, 2] = np.where(cracks[:, 2] == tens, 0.0, 1.0)
     return dict(strain=np.array(strain), stress=np.array(stress), particles=int(len(P)), steps=int(O.iter),
                 wall_time_s=wall, cpu_time_s=cpu, dt=float(O.dt), bonds=int(bonds), tensile_cracks=int(law.nbTensCracks),
                 shear_cracks=int(law.nbShearCracks), cracks=cracks, thickness_m=t, width_m=width, height_m=height,
