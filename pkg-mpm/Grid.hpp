@@ -1,8 +1,29 @@
-// Fixed regular background grid (Eulerian nodes) with boundary planes and an optional node mask.
+// Fixed regular background grid (Eulerian nodes) with boundary planes and a composable node-exclusion mask.
 // Two ghost layers on every side keep every cubic-B-spline stencil inside the arrays, so kernels never
 // branch on array bounds: ghost nodes are simply excluded from the WLS fit (ψ_i = 0 there).
+//
+// Node exclusion (`excluded`, one byte per node, doc/boundaries.md): a node with ANY bit set is left out of
+// every WLS fit. The bits are independent, so each owner sets and clears only its own:
+//   ExGhost   stored node outside the physical grid (not an image of a symmetry plane)   Grid, static
+//   ExBeyond  strictly beyond a one-sided boundary plane ('fixed', 'slip-onesided')      Grid, from planes
+//   ExGap     thin gap between the faces of a flaw (yade_mpm.scene) or user exclusion   scene / user
+//   ExContact covered by a rigid body (Fig. 1b)                                          contact, every step
+// `stencilExcl[b]` counts the excluded nodes of the 4^D stencil whose first node is b, so "is any node of
+// this particle's stencil excluded" is one byte load (computeKernel). Change bits only through setBits /
+// clearBitEverywhere, which keep the counts and the images of symmetry planes consistent.
+//
+// Boundary planes (axis-aligned):
+//   Slip          symmetry plane by reflected images: the nodes within 2 cells beyond the plane carry the
+//                 mirror image of their partners (fold/unfold, below), so every particle sees the nodal field
+//                 of the symmetric full-space problem (exact for uniform states and linear fields; interior
+//                 closed-form stencils). Position on a node line or halfway between two.
+//   Fixed         one-sided WLS: nodes strictly beyond are excluded (ExBeyond), nodes on the plane have all
+//                 velocity components zero; the WLS fit over the active nodes is exact for linear fields that
+//                 vanish on the plane. Position on a node line.
+//   SlipOneSided  as Fixed but only the normal component is zero on the plane (kept to compare costs).
 #pragma once
 #include "MpmTypes.hpp"
+#include <algorithm>
 #include <vector>
 
 namespace mpm {
@@ -24,14 +45,16 @@ inline NodeLanes& lanes(Node<D>& n) { return *reinterpret_cast<NodeLanes*>(&n); 
 template <int D>
 inline const NodeLanes& lanes(const Node<D>& n) { return *reinterpret_cast<const NodeLanes*>(&n); }
 
-enum class BoundaryKind : int { Fixed = 0, Slip = 1 };
+enum class BoundaryKind : int { Fixed = 0, Slip = 1, SlipOneSided = 2 };
+
+enum ExclusionBit : uint8_t { ExGhost = 1, ExBeyond = 2, ExGap = 4, ExContact = 8 };
 
 template <int D>
 struct BoundaryPlane {
 	int          axis;     // 0 = x, 1 = y, 2 = z
-	int          side;     // -1: constrains nodes with coordinate ≤ position, +1: ≥ position
+	int          side;     // -1: material above the plane (constrains nodes with coordinate ≤ position), +1: below
 	Real         position; // [m]
-	BoundaryKind kind;     // Fixed: all velocity components zero; Slip: normal component zero
+	BoundaryKind kind;     // Fixed: all velocity components zero; Slip / SlipOneSided: normal component zero
 };
 
 template <int D>
@@ -46,10 +69,20 @@ struct Grid {
 	IVec   stored;     // stored nodes per axis (cells + 1 + 2·ghost)
 	size_t stride[3];  // linear index strides
 	std::vector<Node<D>> nodes;
-	std::vector<uint8_t> fixMask;  // bit a set: velocity component a is prescribed zero
-	std::vector<uint8_t> excluded; // non-zero = node excluded from WLS fits; bits: ExclUser (ghosts always, user mask), ExclContact
-	enum : uint8_t { ExclUser = 1, ExclContact = 2 };
+	std::vector<uint8_t> fixMask;     // bit a set: velocity component a is prescribed zero
+	std::vector<uint8_t> excluded;    // exclusion bits (ExclusionBit); any bit → left out of the WLS fits
+	std::vector<uint8_t> stencilExcl; // number of excluded nodes in the 4^D stencil starting at this node
+	enum : uint8_t { ExclUser = 4, ExclContact = 8 }; // names used by the contact phase (= ExGap, ExContact)
 	std::vector<BoundaryPlane<D>> planes;
+	Vec allowedLo, allowedHi; // particles must stay in [allowedLo, allowedHi): the physical grid cut by the planes
+
+	// A symmetry plane in stored index units: node line k pairs with k' = twoP − k.
+	struct Mirror {
+		int                 axis, side, twoP;
+		std::vector<size_t> columns; // linear index of the first node (coordinate 0 along axis) of every node line along axis
+		NodeLanes           sign;    // +1, except −1 on the lanes of the normal momentum/force components
+	};
+	std::vector<Mirror> mirrors;
 
 	Grid() = default;
 	Grid(const Vec& o, Real h, const IVec& n) { init(o, h, n); }
@@ -74,8 +107,8 @@ struct Grid {
 		nodes.assign(s, Node<D> {});
 		fixMask.assign(s, 0);
 		excluded.assign(s, 0);
-		for (size_t i = 0; i < s; ++i)
-			if (isGhost(i)) excluded[i] = 1;
+		planes.clear();
+		rebuildPlanes();
 	}
 	size_t size() const { return nodes.size(); }
 	// Stored (ghost-shifted) integer coordinates of linear index i.
@@ -88,6 +121,7 @@ struct Grid {
 		}
 		return c;
 	}
+	// Outside the physical grid (geometrically; a ghost may still be the image of a symmetry plane).
 	bool isGhost(size_t i) const
 	{
 		IVec c = coords(i);
@@ -117,51 +151,271 @@ struct Grid {
 		return u;
 	}
 
+	// ------------------------------------------------------------------ boundary planes
 	void addPlane(const BoundaryPlane<D>& p)
 	{
 		if (p.axis < 0 || p.axis >= D) throw InputError("boundary axis must be in [0, " + std::to_string(D - 1) + "] (got " + std::to_string(p.axis) + ")");
-		if (p.side != -1 && p.side != 1) throw InputError("boundary side must be -1 (lower) or +1 (upper)");
+		if (p.side != -1 && p.side != 1) throw InputError("boundary side must be -1 (material above the plane) or +1 (material below)");
 		requireFinite(p.position, "boundary position");
+		const Real lo = origin[p.axis], hi = upper()[p.axis], tol = 1e-9 * spacing;
+		if (p.position < lo - tol || p.position > hi + tol)
+			throw InputError("boundary position = " + num(p.position) + " m along axis " + std::to_string(p.axis) + " is outside the physical grid [" + num(lo)
+			                 + ", " + num(hi) + "] m");
+		// Exact treatments need node lines: no plane is silently moved to the nearest one.
+		const Real f = (p.position - lo) / spacing, f2 = 2 * f;
+		if (p.kind == BoundaryKind::Slip) {
+			if (std::abs(f2 - std::round(f2)) > 1e-6)
+				throw InputError("boundary position = " + num(p.position) + " m of a 'slip' plane along axis " + std::to_string(p.axis)
+				                 + " must lie on a grid node line or halfway between two (origin + k·l/2 with l = " + num(spacing) + " m; nearest: "
+				                 + num(lo + std::round(f2) * spacing / 2) + " m)");
+		} else if (std::abs(f - std::round(f)) > 1e-6)
+			throw InputError("boundary position = " + num(p.position) + " m of a '" + kindName(p.kind) + "' plane along axis " + std::to_string(p.axis)
+			                 + " must lie on a grid node line (origin + k·l with l = " + num(spacing) + " m; nearest: " + num(lo + std::round(f) * spacing)
+			                 + " m); move the plane or the grid origin");
+		for (const auto& q : planes) {
+			if (q.axis != p.axis) continue;
+			if (q.side == p.side)
+				throw InputError("a boundary plane with axis " + std::to_string(p.axis) + " and side " + std::to_string(p.side) + " exists already (at "
+				                 + num(q.position) + " m)");
+			const Real below = p.side < 0 ? p.position : q.position, above = p.side < 0 ? q.position : p.position;
+			if (above - below < 2 * spacing - tol)
+				throw InputError("boundary planes along axis " + std::to_string(p.axis) + " at " + num(below) + " m (side -1) and " + num(above)
+				                 + " m (side +1) must enclose at least 2 grid cells (l = " + num(spacing) + " m)");
+		}
 		planes.push_back(p);
-		rebuildFixMask();
+		rebuildPlanes();
 	}
 	void clearPlanes()
 	{
 		planes.clear();
-		rebuildFixMask();
+		rebuildPlanes();
 	}
-	void rebuildFixMask()
+	bool hasMirrors() const { return !mirrors.empty(); }
+	static const char* kindName(BoundaryKind k) { return k == BoundaryKind::Fixed ? "fixed" : k == BoundaryKind::Slip ? "slip" : "slip-onesided"; }
+
+	// Rebuilds everything derived from the planes: fixed components, ghost and beyond bits, mirrors, counts.
+	void rebuildPlanes()
 	{
-		std::fill(fixMask.begin(), fixMask.end(), 0);
-		const Real tol = 1e-9 * spacing;
-		for (size_t i = 0; i < size(); ++i) {
-			Vec x = position(i);
-			for (const auto& p : planes) {
-				bool hit = p.side < 0 ? x[p.axis] <= p.position + tol : x[p.axis] >= p.position - tol;
-				if (!hit) continue;
-				fixMask[i] |= p.kind == BoundaryKind::Fixed ? uint8_t((1 << D) - 1) : uint8_t(1 << p.axis);
-			}
+		const size_t s = size();
+		mirrors.clear();
+		allowedLo = origin, allowedHi = upper();
+		for (const auto& p : planes) {
+			const int twoP = int(std::lround(2 * (p.position - origin[p.axis]) / spacing)) + 2 * ghost;
+			if (p.side < 0) allowedLo[p.axis] = std::max(allowedLo[p.axis], p.position);
+			else allowedHi[p.axis] = std::min(allowedHi[p.axis], p.position);
+			if (p.kind != BoundaryKind::Slip) continue;
+			Mirror m;
+			m.axis = p.axis, m.side = p.side, m.twoP = twoP;
+			for (int l = 0; l < 8; ++l) m.sign[l] = 1;
+			m.sign[2 + p.axis] = m.sign[2 + D + p.axis] = -1;
+			for (size_t i = 0; i < s; ++i)
+				if (coords(i)[p.axis] == 0) m.columns.push_back(i);
+			mirrors.push_back(std::move(m));
 		}
+		std::fill(fixMask.begin(), fixMask.end(), 0);
+		for (size_t i = 0; i < s; ++i) {
+			const IVec c   = coords(i);
+			uint8_t    bit = excluded[i] & ~uint8_t(ExGhost | ExBeyond);
+			for (int a = 0; a < D; ++a)
+				if ((c[a] < ghost || c[a] > cells[a] + ghost) && !mirroredAlong(a, c[a])) bit |= ExGhost;
+			for (const auto& p : planes) {
+				const int twoP = int(std::lround(2 * (p.position - origin[p.axis]) / spacing)) + 2 * ghost;
+				const int d2   = p.side * (2 * c[p.axis] - twoP); // > 0: beyond the plane, = 0: on it
+				if (d2 == 0) fixMask[i] |= p.kind == BoundaryKind::Fixed ? uint8_t((1 << D) - 1) : uint8_t(1 << p.axis);
+				else if (d2 > 0 && p.kind != BoundaryKind::Slip) bit |= ExBeyond;
+			}
+			excluded[i] = bit;
+		}
+		// images of symmetry planes carry their partner's gap/contact bits
+		for (size_t i = 0; i < s; ++i) {
+			size_t src = partnerOf(i);
+			if (src != i) excluded[i] = (excluded[i] & uint8_t(ExGhost | ExBeyond)) | (excluded[src] & uint8_t(~(ExGhost | ExBeyond)));
+		}
+		recountStencils();
 	}
-	// Mark a physical node excluded from the WLS fits (e.g. a node covered by a rigid body).
+
+	// ------------------------------------------------------------------ exclusion bits
+	// Sets (on = true) or clears bits of physical node i; images of symmetry planes follow their partner,
+	// and writes to an image itself are ignored (its partner decides).
+	void setBits(size_t i, uint8_t bits, bool on)
+	{
+		if (partnerOf(i) != i) return;
+		forImages(i, [&](size_t j) { writeBits(j, bits, on); });
+	}
+	// Clears a bit on every node (e.g. the contact phase before marking the nodes of this step).
+	void clearBitEverywhere(uint8_t bit)
+	{
+		bool changed = false;
+		for (size_t i = 0; i < size(); ++i)
+			if (excluded[i] & bit) excluded[i] &= uint8_t(~bit), changed = true;
+		if (changed) recountStencils();
+	}
+	// The user/gap exclusion of one physical node (Python: setNodeExcluded).
 	void setExcluded(size_t i, bool ex)
 	{
 		if (i >= size()) throw InputError("node index " + std::to_string(i) + " is outside [0, " + std::to_string(size() - 1) + "]");
 		if (isGhost(i)) throw InputError("node index " + std::to_string(i) + " is a ghost node outside the physical grid");
-		if (bool(excluded[i] & ExclUser) == ex) return;
-		excluded[i] = ex ? (excluded[i] | ExclUser) : (excluded[i] & ~ExclUser);
-		nUserExcluded += ex ? 1 : -1;
+		setBits(i, ExGap, ex);
 	}
 	// Contact's own bit (a node covered by a rigid body, Fig. 1b), set and cleared every step by the contact
-	// phase without touching the user bit. No range check: the contact phase passes physical nodes only.
-	void setContactExcluded(size_t i, bool ex)
+	// phase without touching the other bits. No range check: the contact phase passes physical nodes only.
+	void setContactExcluded(size_t i, bool ex) { setBits(i, ExContact, ex); }
+	bool isExcluded(size_t i) const { return excluded[i] != 0; }
+	// Any excluded node in the stencil whose first node is `base` (one load; the kernels' branch).
+	bool stencilHasExcluded(size_t base) const { return stencilExcl[base] != 0; }
+
+	// ------------------------------------------------------------------ symmetry planes: fold / unfold
+	// A particle next to a symmetry plane has a reflected image beyond it. The image's contribution to node k
+	// equals the reflection of the particle's own contribution to the partner node k' = twoP − k (cubic
+	// B-splines are even; mass and the tangential components are even, the normal components odd), so after a
+	// scatter every node on the material side within 2 cells adds the reflected content of its partner
+	// (fold), and afterwards every node beyond takes the reflection of its partner (unfold): the nodal field
+	// is then exactly that of the mirror-symmetric full-space problem. Both are orphaned OpenMP loops over
+	// the node lines along the plane's axis (called inside the step's parallel region; each line is handled
+	// by one thread in a fixed order → bitwise identical results for any thread count). Planes are folded
+	// in order and unfolded in reverse order, so corners of two planes get all reflected images.
+	// `mask`: 1 on the lanes to fold (all after P2G; the MUSL momentum lanes after G2P).
+	void foldMirrors(const NodeLanes& mask)
 	{
-		if (bool(excluded[i] & ExclContact) == ex) return;
-		excluded[i] = ex ? (excluded[i] | ExclContact) : (excluded[i] & ~ExclContact);
-		nContactExcluded += ex ? 1 : -1;
+		for (const auto& m : mirrors) {
+			const NodeLanes ms = mask * m.sign;
+			const size_t    st = stride[m.axis];
+			const long      nc = long(m.columns.size());
+#pragma omp for schedule(static)
+			for (long c = 0; c < nc; ++c) {
+				const size_t col = m.columns[size_t(c)];
+				forPairs(m, [&](int k, int kp) { lanes(nodes[col + size_t(k) * st]) += ms * lanes(nodes[col + size_t(kp) * st]); });
+			}
+		}
 	}
-	bool userExclusions() const { return nUserExcluded > 0 || nContactExcluded > 0; }
-	long nUserExcluded = 0, nContactExcluded = 0;
+	void unfoldMirrors()
+	{
+		for (auto it = mirrors.rbegin(); it != mirrors.rend(); ++it) {
+			const auto&  m  = *it;
+			const size_t st = stride[m.axis];
+			const long   nc = long(m.columns.size());
+#pragma omp for schedule(static)
+			for (long c = 0; c < nc; ++c) {
+				const size_t col = m.columns[size_t(c)];
+				forPairs(m, [&](int k, int kp) {
+					if (k != kp) lanes(nodes[col + size_t(kp) * st]) = m.sign * lanes(nodes[col + size_t(k) * st]);
+				});
+			}
+		}
+	}
+	static NodeLanes allLanes()
+	{
+		NodeLanes l;
+		for (int i = 0; i < 8; ++i) l[i] = 1;
+		return l;
+	}
+	static NodeLanes secondVectorLanes() // lanes b (MUSL momentum)
+	{
+		NodeLanes l = {};
+		for (int a = 0; a < D; ++a) l[2 + D + a] = 1;
+		return l;
+	}
+
+private:
+	static std::string num(Real v)
+	{
+		char b[32];
+		snprintf(b, sizeof(b), "%g", v);
+		return b;
+	}
+	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
+	// including the line on the plane (k == kp).
+	template <class F>
+	void forPairs(const Mirror& m, F&& f) const
+	{
+		for (int k = 0; k < stored[m.axis]; ++k) {
+			const int d2 = -m.side * (2 * k - m.twoP); // ≥ 0 on the material side (half cells)
+			if (d2 < 0 || d2 >= 4) continue;
+			const int kp = m.twoP - k;
+			if (kp < 0 || kp >= stored[m.axis]) continue;
+			f(k, kp);
+		}
+	}
+	// Stored coordinate k along axis a lies beyond a symmetry plane within 2 cells, with its partner inside
+	// the physical grid.
+	bool mirroredAlong(int a, int k) const
+	{
+		for (const auto& m : mirrors) {
+			if (m.axis != a) continue;
+			const int d2 = m.side * (2 * k - m.twoP);
+			const int kp = m.twoP - k;
+			if (d2 > 0 && d2 < 4 && kp >= ghost && kp <= cells[a] + ghost) return true;
+		}
+		return false;
+	}
+	// The node whose content node i mirrors (i itself when i is not an image).
+	size_t partnerOf(size_t i) const
+	{
+		if (mirrors.empty()) return i;
+		IVec c = coords(i);
+		for (int r = 0; r < 3; ++r) // an image of an image (corner): repeat until on the material side
+			for (const auto& m : mirrors) {
+				const int d2 = m.side * (2 * c[m.axis] - m.twoP);
+				if (d2 > 0 && d2 < 4) c[m.axis] = m.twoP - c[m.axis];
+			}
+		return linear(c);
+	}
+	// Node i and all its images across the symmetry planes (corners included).
+	template <class F>
+	void forImages(size_t i, F&& f) const
+	{
+		size_t list[8] = { i };
+		int    n       = 1;
+		for (const auto& m : mirrors) {
+			const int cur = n;
+			for (int j = 0; j < cur; ++j) {
+				IVec      c  = coords(list[j]);
+				const int d2 = -m.side * (2 * c[m.axis] - m.twoP);
+				if (d2 > 0 && d2 < 4) {
+					c[m.axis] = m.twoP - c[m.axis];
+					if (c[m.axis] >= 0 && c[m.axis] < stored[m.axis] && n < 8) list[n++] = linear(c);
+				}
+			}
+		}
+		for (int j = 0; j < n; ++j) f(list[j]);
+	}
+	void writeBits(size_t i, uint8_t bits, bool on)
+	{
+		const uint8_t old = excluded[i], now = on ? uint8_t(old | bits) : uint8_t(old & ~bits);
+		excluded[i]       = now;
+		if (bool(old) == bool(now)) return;
+		const IVec c = coords(i);
+		// stencils starting at c − j (j = 0..3 per axis) contain node i
+		for (int n = 0; n < Dim<D>::nStencil; ++n) {
+			IVec b;
+			bool ok = true;
+			for (int a = 0; a < D; ++a) {
+				b[a] = c[a] - ((n >> (2 * a)) & 3);
+				ok   = ok && b[a] >= 0 && b[a] + 3 < stored[a];
+			}
+			if (!ok) continue;
+			auto& cnt = stencilExcl[linear(b)];
+			cnt       = now ? uint8_t(cnt + 1) : uint8_t(cnt - 1);
+		}
+	}
+	// stencilExcl from scratch: separable box sums of (excluded ≠ 0) over 4 nodes along each axis.
+	void recountStencils()
+	{
+		const size_t         s = size();
+		std::vector<uint8_t> in(s), out(s);
+		for (size_t i = 0; i < s; ++i) in[i] = excluded[i] != 0;
+		for (int a = 0; a < D; ++a) {
+			for (size_t i = 0; i < s; ++i) {
+				const int k = coords(i)[a];
+				uint8_t   t = 0;
+				if (k + 3 < stored[a])
+					for (int j = 0; j < 4; ++j) t += in[i + size_t(j) * stride[a]];
+				out[i] = t;
+			}
+			std::swap(in, out);
+		}
+		stencilExcl = std::move(in);
+	}
 };
 
 } // namespace mpm

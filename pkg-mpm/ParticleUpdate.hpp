@@ -59,6 +59,7 @@ inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool
 	const auto&    blocks = tr.sched.start;
 	const long     nb     = long(blocks.size()) - 1;
 	const auto     lo = grid.origin, hi = grid.upper();
+	const auto     alo = grid.allowedLo, ahi = grid.allowedHi; // the grid cut by the boundary planes
 	const Real     invH  = 1.0 / grid.spacing;
 	Real           v2max = 0;
 	bool           drift = false;
@@ -75,7 +76,7 @@ inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool
 				P.x[a][p] = xa;
 				sp += va * va;
 				check += xa;
-				inside = inside && xa >= lo[a] && xa < hi[a];
+				inside = inside && xa >= alo[a] && xa < ahi[a];
 				const Real f = (xa - lo[a]) * invH;
 				near = near && f >= cellLo[a] && f < cellHi[a];
 			}
@@ -91,6 +92,10 @@ inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool
 					if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
 						err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (grid spans ["
 						                      + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m)");
+						break;
+					} else if (P.x[a][p] < alo[a] || P.x[a][p] >= ahi[a]) {
+						err.record(p, "crossed a boundary plane along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (allowed: ["
+						                      + fmtNum(alo[a]) + ", " + fmtNum(ahi[a]) + ") m)");
 						break;
 					}
 				continue;

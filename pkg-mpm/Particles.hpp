@@ -103,7 +103,7 @@ struct Particles {
 			for (int a = 0; a < D; ++a)
 				if (!(x[a][p] >= lo[a] && x[a][p] < hi[a]))
 					throw InputError("position of " + who() + " along axis " + std::to_string(a) + " = " + fmtNum(x[a][p])
-					                 + " m is not finite or outside the grid [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m");
+					                 + " m is not finite or outside the grid cut by the boundary planes [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m");
 			if (!(std::isfinite(mass[p]) && mass[p] > 0)) throw InputError("mass of " + who() + " = " + fmtNum(mass[p]) + " kg must be finite and > 0");
 			if (!(std::isfinite(vol[p]) && vol[p] > 0)) throw InputError("volume of " + who() + " = " + fmtNum(vol[p]) + " m³ must be finite and > 0");
 			if (mat[p] >= nMaterials)

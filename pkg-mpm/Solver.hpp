@@ -88,7 +88,11 @@ public:
 	const MaterialSet<D>& materialSet() const { return materials; }
 	MaterialKind          materialKind() const { return materials.size() ? materials[0].kind : MaterialKind::None; } // of material 0
 
-	void addBoundaryPlane(int axis, int side, Real position, BoundaryKind k) { grid.addPlane({ axis, side, position, k }); }
+	void addBoundaryPlane(int axis, int side, Real position, BoundaryKind k)
+	{
+		grid.addPlane({ axis, side, position, k });
+		needCheck = true; // particles must lie on the material side of every plane
+	}
 
 	// Surface force on particle slot p (traction × tributary area) [N].
 	void setParticleForce(size_t p, const Vec& f)
@@ -132,6 +136,7 @@ public:
 		errP2G.clear(), errContact.clear(), errG2P.clear();
 		ContactStep<D> cs { xfer, dt, time, massFloor, errContact };
 		const bool     withContact = contact.active();
+		const bool     mirrors     = grid.hasMirrors(); // symmetry planes: fold/unfold the reflected images
 		if (withContact) contact.beforeTransfer(cs);
 		const Vec  g = gravity;
 		const Real s = loadScale(time);
@@ -142,6 +147,7 @@ public:
 #pragma omp parallel
 			{
 				xfer.p2g(mat, g, s, errP2G);
+				if (mirrors) grid.foldMirrors(Grid<D>::allLanes()); // symmetry planes: add the reflected images
 				stamp(t[1]);
 				if (errP2G.none()) {
 					gridUpdate(grid, dt, damping, massFloor);
@@ -150,10 +156,15 @@ public:
 						contact.apply(cs);
 #pragma omp barrier
 					}
+					if (mirrors) grid.unfoldMirrors(); // nodes beyond a symmetry plane take their partner's reflection
 					stamp(t[3]);
 					if (errContact.none()) {
 						xfer.g2p(errG2P);
-						if (errG2P.none()) gridMusl(grid, massFloor);
+						if (errG2P.none()) {
+							if (mirrors) grid.foldMirrors(Grid<D>::secondVectorLanes());
+							gridMusl(grid, massFloor);
+							if (mirrors) grid.unfoldMirrors();
+						}
 					}
 				}
 				stamp(t[4]);
@@ -261,7 +272,7 @@ private:
 		if (!std::isfinite(rhoMin) || needCheck) {
 			// State edited through the live views (requestSort() after editing) is validated like
 			// addParticles input: a NaN or off-grid position would index outside the node arrays.
-			const auto c = P.check(grid.origin, grid.upper(), materials.size());
+			const auto c = P.check(grid.allowedLo, grid.allowedHi, materials.size()); // the grid cut by the boundary planes
 			P.checkDamageState([&](size_t p) { // ε_D⁰ is checked where the particle's material has damage on
 				const auto& e = materials.of(P, p);
 				return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;

@@ -2,8 +2,9 @@
 //
 // For a particle whose 4^D stencil nodes are all active, the moment matrix of the cubic B-spline is
 // exactly M = diag(1, l²/3, …) (partition of unity, zero first moment, second moment 1/3 cell²), so
-// ψ_i = w_i and ∇ψ_i = w_i·3/l²·(x_i − x_p). Near the grid edge or when nodes are excluded, M is built
-// from the active nodes only and inverted: the fit stays exact for linear fields.
+// ψ_i = w_i and ∇ψ_i = w_i·3/l²·(x_i − x_p). When some stencil node is excluded (ghost, beyond a one-sided
+// plane, thin gap, contact: Grid.hpp), M is built from the active nodes only and inverted: the fit stays
+// exact for linear fields. Images of symmetry planes are active nodes (closed form).
 #pragma once
 #include "Grid.hpp"
 #include <Eigen/LU>
@@ -61,7 +62,7 @@ struct Kernel {
 	size_t base;    // linear index of stencil node (0,0[,0])
 	Real   w[D][4]; // one-dimensional cubic B-spline weights, Eq. 13
 	Real   d[D][4]; // x_i − x_p per axis for the 4 stencil layers [m]
-	bool   general; // some stencil node is a ghost or excluded: use computeStencil
+	bool   general; // some stencil node is excluded (any bit of Grid::excluded): use fillStencil's general path
 	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
 
@@ -69,7 +70,6 @@ template <int D>
 inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Kernel<D>& k)
 {
 	const Real h = g.spacing, invH = 1.0 / g.spacing;
-	bool       nearEdge = false;
 	size_t     base     = 0;
 	k.inside            = true;
 	for (int a = 0; a < D; ++a) {
@@ -86,14 +86,11 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 		k.w[a][2] = 0.5 * u * u * u - u * u + 2.0 / 3.0;
 		k.w[a][3] = t * t * t * (1.0 / 6.0);
 		for (int j = 0; j < 4; ++j) k.d[a][j] = (j - 1 - t) * h;
-		if (c - 1 < 0 || c + 2 > g.cells[a]) nearEdge = true;
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
-	k.base  = base;
-	bool general = nearEdge;
-	if (!general && g.userExclusions())
-		for (int n = 0; n < Dim<D>::nStencil && !general; ++n) general = g.excluded[base + so.off[n]];
-	k.general = general;
+	k.base    = base;
+	k.general = g.stencilHasExcluded(base); // one load: ghosts near the grid edge, planes, gaps, contact
+	(void)so;
 }
 
 // Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit

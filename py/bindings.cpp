@@ -168,7 +168,8 @@ struct SolverWrap {
 		BoundaryKind k;
 		if (kind == "fixed") k = BoundaryKind::Fixed;
 		else if (kind == "slip") k = BoundaryKind::Slip;
-		else throw InputError("boundary kind must be 'fixed' or 'slip' (got '" + kind + "')");
+		else if (kind == "slip-onesided") k = BoundaryKind::SlipOneSided;
+		else throw InputError("boundary kind must be 'fixed', 'slip' or 'slip-onesided' (got '" + kind + "')");
 		s.addBoundaryPlane(axis, side, pos, k);
 	}
 
@@ -520,6 +521,13 @@ struct SolverWrap {
 	}
 	static bool contactActive(S& s) { return s.contact.active(); }
 
+	// Exclusion bits of every stored node (copy): 1 ghost, 2 beyond a one-sided plane, 4 thin gap/user, 8 contact.
+	static np::ndarray nodeExclusion(S& s)
+	{
+		np::ndarray out = np::empty(bp::make_tuple(s.grid.size()), np::dtype::get_builtin<uint8_t>());
+		std::copy(s.grid.excluded.begin(), s.grid.excluded.end(), reinterpret_cast<uint8_t*>(out.get_data()));
+		return out;
+	}
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
 	static void expose(const char* name)
@@ -573,6 +581,7 @@ struct SolverWrap {
 		        .def("contactNodeForces", &contactNodeForces)
 		        .def("excludedNodes", &excludedNodes)
 		        .add_property("contactActive", &contactActive)
+		        .def("nodeExclusion", &nodeExclusion)
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("requestSort", &S::requestSort)

@@ -311,7 +311,9 @@ def main(argv=None):
     ap.add_argument("--flaws", type=int, default=0, help="Benz–Asphaug flaws per particle (DpGkMat.flawCount); 0 = one threshold")
     ap.add_argument("--flaw-seed", type=int, default=0, help="seed of the flaw population (DpGkMat.flawSeed)")
     ap.add_argument("--crack-nodes", choices=("shared", "excluded"), default="shared",
-                    help="grid nodes on the crack mid-line: shared by both faces (paper) or excluded from the WLS fits")
+                    help="grid nodes on the crack mid-line: shared by both faces (paper) or excluded from the WLS fits "
+                         "(cases.line_crack's default, converges to Sneddon: doc/boundaries.md)")
+    ap.add_argument("--half-length", type=float, default=cases.CRACK_HALF_LENGTH, help="crack half-length c [m] (paper 0.2)")
     ap.add_argument("--edges", choices=("free", "slip", "fixed"), default="slip",
                     help="outer boundary of the block: slip (normal velocity 0, default: a supported block, "
                          "doc/penny_crack.md), fixed, or free (the figure's unsupported block)")
@@ -331,6 +333,10 @@ def main(argv=None):
             ap.error(f"--{name.replace('_', '-')} must be > 0")
     if not 0 < a.end_time <= PAPER_RAMP:
         ap.error(f"--end-time must lie in (0, {PAPER_RAMP}] s")
+    if not 0 < a.half_length < a.size / 4:
+        ap.error(f"--half-length must lie in (0, size/4) = (0, {a.size / 4:g}) m")
+    global HALF_CRACK
+    HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
     if a.full:
         a.spacing = 0.02
     if a.threads > 0:
@@ -342,7 +348,7 @@ def main(argv=None):
                                threshold_volume=next(k for k, v in THRESHOLD_VOLUMES.items()
                                                      if v == rocks.granite_dpgk(**damage_options(a, 0)).thresholdVolume),
                                damage_strain=a.damage_strain,
-                               threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes,
+                               threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
                                edges=a.edges, edge_set=a.edge_set, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
                                threads=ym.getThreads()))
     wall0 = time.time()

@@ -27,32 +27,38 @@ OPENING_SXX = 20e6          # far-field compression σxx [Pa], compression posit
 OPENING_SYY = 10e6          # far-field compression σyy [Pa]
 
 
-def apply_far_field(solver, lo, hi, ppc, sxx, syy, boundary_load="consistent"):
+def apply_far_field(solver, lo, hi, ppc, sxx, syy, boundary_load="consistent", sides=(-1, 1)):
     """Far-field traction t = σ0·n (σ0 = diag(sxx, syy), tension positive [Pa]) on the four faces of
     the 2D block [lo, hi] [m]: spread over the outer particle rows with ``consistent_row_weights``
     (boundary_load="consistent", exact discrete equilibrium of the intact block) or on the outermost
-    row only ("outer-row")."""
+    row only ("outer-row"). sides: the faces loaded along each axis (a quarter model loads only +1)."""
     if boundary_load not in ("consistent", "outer-row"):
         raise ValueError(f"boundary_load = {boundary_load!r} must be 'consistent' or 'outer-row'")
     for axis, far in ((0, sxx), (1, syy)):
-        for side, face in ((-1, lo[axis]), (1, hi[axis])):
+        for side, face in ((sd, lo[axis] if sd < 0 else hi[axis]) for sd in sides):
             t = np.zeros(2)
             t[axis] = side * far                  # σ0·n with n = side·e_axis: compression pushes inwards
             apply_face_traction(solver, axis, side, face, t, ppc, consistent=(boundary_load == "consistent"))
 
 
-def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="consistent", material=None):
+def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="consistent", material=None, quarter=False):
     """Square block of side `domain` [m] centred on (2.5, 2.5) m with a hole of radius 0.1 m, every
     particle at the in-situ stress (σxx, σyy) = (−20, −10) MPa, σzz = ν(σxx + σyy) (plane strain), and
     the far-field traction on its faces, so only the hole wall is out of balance ("excavation").
-    material: default ``rocks.granite()``. Returns (solver, lo, hi)."""
+    material: default ``rocks.granite()``. quarter=True models the quadrant x, y ≥ 2.5 m only, with
+    slip (symmetry) planes on x = 2.5 m and y = 2.5 m (doc/boundaries.md). Returns (solver, lo, hi)."""
     mat = material or rocks.granite()
     lo, hi = np.full(2, OPENING_CENTER - domain / 2), np.full(2, OPENING_CENTER + domain / 2)
+    if quarter:
+        lo = np.full(2, OPENING_CENTER)
     s = make_solver(lo, hi, spacing, margin=2)
     add_region(s, mat, lo, hi, ppc=ppc, holes=[Circle((OPENING_CENTER, OPENING_CENTER), OPENING_RADIUS)])
     sxx, syy = -OPENING_SXX, -OPENING_SYY     # tension positive inside the solver
     set_initial_stress(s, (sxx, syy, mat.poisson * (sxx + syy), 0.0))
-    apply_far_field(s, lo, hi, ppc, sxx, syy, boundary_load)
+    apply_far_field(s, lo, hi, ppc, sxx, syy, boundary_load, sides=(1,) if quarter else (-1, 1))
+    if quarter:
+        s.addBoundaryPlane(0, -1, OPENING_CENTER, "slip")
+        s.addBoundaryPlane(1, -1, OPENING_CENTER, "slip")
     s.damping = damping
     return s, lo, hi
 
@@ -62,22 +68,26 @@ def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="con
 CRACK_HALF_LENGTH = 0.2     # c [m] (crack length 0.4 m)
 
 
-def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="shared", half_length=CRACK_HALF_LENGTH):
+def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="excluded", half_length=CRACK_HALF_LENGTH):
     """Square block [0, size]² [m] with a line crack of half-length c at its centre, made by removing
     the particles of two cell layers (ppc = 2); the crack faces carry the pressure P [Pa] as a particle
-    traction, ramped linearly over `ramp` [s]. crack_nodes = "excluded" takes the grid nodes on the
-    crack's mid-line out of the WLS fits (the cubic B-spline reaches 2 cells, so with "shared" both
-    faces, 2 cells apart, map to that node row and stay weakly tied).
+    traction, ramped linearly over `ramp` [s]. crack_nodes = "excluded" (default) takes the grid nodes
+    between the faces out of the WLS fits (``add_region(gap_nodes="excluded")``, ``scene.thin_gap_nodes``):
+    the faces are 2 cells apart and the cubic B-spline reaches 2 cells, so with "shared" (the paper's
+    construction) both faces map to the mid-line node row and stay tied — the opening then moves away
+    from Sneddon as the grid is refined (doc/boundaries.md).
 
     Returns (solver, geo): geo = dict(xc, yc, h, dp, x0 (initial positions by id), top, bot (particle
     ids of the loaded face rows), half_length)."""
     if crack_nodes not in ("shared", "excluded"):
         raise ValueError(f"crack_nodes = {crack_nodes!r} must be 'shared' or 'excluded'")
+    if not (np.isfinite(half_length) and 0 < half_length < size / 2 - 2 * spacing):
+        raise ValueError(f"half_length = {half_length} m must lie in (0, size/2 − 2·spacing) = (0, {size / 2 - 2 * spacing:g}) m")
     h = spacing
     s = make_solver((0, 0), (size, size), h, margin=2)
     xc = yc = round(size / 2 / h) * h   # crack centre on a grid line so the hole is exactly two cell layers
     crack = Box((xc - half_length, yc - h), (xc + half_length, yc + h))
-    add_region(s, material, (0, 0), (size, size), ppc=2, holes=[crack])
+    add_region(s, material, (0, 0), (size, size), ppc=2, holes=[crack], gap_nodes=crack_nodes)
     x0 = get(s, "pos")                  # by particle id (== storage slot before the first step)
     dp = h / 2                          # particle spacing
     along = np.abs(x0[:, 0] - xc) < half_length
@@ -86,11 +96,6 @@ def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="sh
     # pressure P on the faces: traction −P n, n the outward normal of the solid (−y on the upper face)
     apply_traction(s, top, (0.0, pressure), dp)
     apply_traction(s, bot, (0.0, -pressure), dp)
-    if crack_nodes == "excluded":
-        xn = s.nodePositions()
-        inner = (np.abs(xn[:, 1] - yc) < h / 4) & (np.abs(xn[:, 0] - xc) < half_length - h / 4)
-        for i in np.nonzero(inner)[0]:
-            s.setNodeExcluded(int(i), True)
     s.damping = damping
     s.tractionRampTime = ramp
     return s, dict(xc=xc, yc=yc, h=h, dp=dp, x0=x0, top=top, bot=bot, half_length=half_length)

@@ -57,6 +57,10 @@ class Circle:
     def contains(self, x):
         return np.sum((x - self.center) ** 2, axis=1) < self.radius ** 2
 
+    def width(self):
+        """Narrowest extent [m] (thin holes: yade_mpm.scene.thin_gap_nodes)."""
+        return 2 * self.radius
+
 
 class Box:
     """Axis-aligned box [lo, hi] [m]."""
@@ -66,6 +70,10 @@ class Box:
 
     def contains(self, x):
         return np.all((x >= self.lo) & (x <= self.hi), axis=1)
+
+    def width(self):
+        """Narrowest extent [m]."""
+        return float(np.min(self.hi - self.lo))
 
 
 class Polygon:
@@ -96,6 +104,14 @@ class Polygon:
                 xint = x1 + (py - y1) * (x2 - x1) / (y2 - y1)
             inside ^= crosses & (px < xint)
         return inside
+
+    def width(self):
+        """Narrowest extent [m] of the convex hull (the smallest extent across an edge direction)."""
+        v = self.v
+        e = np.roll(v, -1, axis=0) - v
+        n = np.column_stack([-e[:, 1], e[:, 0]]) / np.linalg.norm(e, axis=1)[:, None]
+        proj = v @ n.T
+        return float(np.min(proj.max(axis=0) - proj.min(axis=0)))
 
 
 def rotated_rectangle(center, length, width, angle):

@@ -42,19 +42,89 @@ def dim_of(solver):
     raise ValueError(f"solver must be a Solver2D or Solver3D (got {type(solver).__name__})")
 
 
-def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None):
+GAP_NODES = ("excluded", "shared")
+
+
+def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="excluded"):
     """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2).
     Each region keeps its own material (several materials per scene, e.g. rock with an elastic infill):
     the material is added to the solver (an identical one already there is reused) and the damage
-    thresholds of the new particles follow from it. Returns the ids of the new particles."""
+    thresholds of the new particles follow from it. Returns the ids of the new particles.
+
+    gap_nodes: "excluded" (default) takes the grid nodes inside thin holes (a flaw or hole narrower than
+    the cubic B-spline support, 4 cells) out of the WLS fits, so the two faces are not tied through
+    shared nodes (thin_gap_nodes); "shared" keeps them (the paper's construction). Particles of a later
+    region that fill such a gap (a filled flaw) put its nodes back into the fits."""
     d = dim_of(solver)
     if np.ndim(lo) != 1 or len(lo) != d:
         raise ValueError(f"region lo = {lo} must have {d} components for a {d}D solver")
+    if gap_nodes not in GAP_NODES:
+        raise ValueError(f"gap_nodes = {gap_nodes!r} must be one of {GAP_NODES}")
     x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
     first = solver.numParticles
     index = material_index(solver, material)
     solver.addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
+    _refill_gaps(solver, solver.spacing / ppc)
+    if gap_nodes == "excluded" and len(holes):
+        for i in thin_gap_nodes(solver, lo, hi, solver.spacing / ppc, holes):
+            solver.setNodeExcluded(int(i), True)
     return np.arange(first, first + len(x))
+
+
+def thin_gap_nodes(solver, lo, hi, dp, holes):
+    """Grid nodes (stored indices) that tie the two faces of a thin gap: strictly inside a hole narrower
+    than the cubic B-spline support (hole.width() < 4 cells; a flaw, a slot, a hole of diameter < 4 cells),
+    empty (no particle's cell, a square of side dp [m], contains the node) and reaching particles on BOTH
+    sides along some grid axis within its support (2 cells), in a tube of half-width dp/2 around the node's
+    axis line. Such a node would move both faces with one velocity. Nodes of wide openings, nodes on a
+    hole's boundary (its tips) and nodes reaching one face only are kept, so a particle that later moves
+    into the gap still has active nodes on both sides for its WLS fit (tests/test_boundaries.py).
+    Only nodes strictly inside the box [lo, hi] [m]; every particle in the solver counts."""
+    from scipy.spatial import cKDTree
+    d = dim_of(solver)
+    h = solver.spacing
+    thin = [g for g in holes if g.width() < 4 * h]
+    if not thin:
+        return np.zeros(0, np.int64)
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    xn = solver.nodePositions()
+    cand = np.nonzero(np.all((xn > lo + 1e-9 * h) & (xn < hi - 1e-9 * h), axis=1))[0]
+    # strictly inside a thin hole: the node and its 3^D − 1 neighbours at 1e-6 l are all inside
+    offsets = 1e-6 * h * (np.array(np.meshgrid(*[[-1, 0, 1]] * d, indexing="ij")).reshape(d, -1).T)
+    strict = np.zeros(len(cand), bool)
+    for g in thin:
+        strict |= np.all([g.contains(xn[cand] + o) for o in offsets], axis=0)
+    cand = cand[strict]
+    if len(cand) == 0:
+        return np.zeros(0, np.int64)
+    xp = np.column_stack([solver.view(f"x{a}") for a in range(d)])
+    tree = cKDTree(xp)
+    near, _ = tree.query(xn[cand], p=np.inf)
+    cand = cand[near > 0.5 * dp * (1 + 1e-6)]                 # empty
+    out = []
+    for i, nb in zip(cand, tree.query_ball_point(xn[cand], 2 * h * (1 - 1e-9), p=np.inf)):
+        if not nb:
+            continue
+        r = xp[nb] - xn[i]
+        for a in range(d):
+            tube = np.all(np.abs(np.delete(r, a, axis=1)) <= 0.5 * dp * (1 + 1e-6), axis=1)
+            if np.any(tube & (r[:, a] > 0)) and np.any(tube & (r[:, a] < 0)):
+                out.append(i)
+                break
+    return np.array(out, dtype=np.int64)
+
+
+def _refill_gaps(solver, dp):
+    """Gap nodes that particles added since now cover (a filled flaw) take part in the fits again."""
+    from scipy.spatial import cKDTree
+    gap = np.nonzero(solver.nodeExclusion() & 4)[0]
+    if len(gap) == 0:
+        return
+    d = dim_of(solver)
+    tree = cKDTree(np.column_stack([solver.view(f"x{a}") for a in range(d)]))
+    near, _ = tree.query(solver.nodePositions()[gap], p=np.inf)
+    for i in gap[near <= 0.5 * dp * (1 + 1e-6)]:
+        solver.setNodeExcluded(int(i), False)
 
 
 def material_index(solver, material):
