@@ -303,6 +303,29 @@ struct Grid {
 			}
 		}
 	}
+	// The same reflection for per-node arrays kept outside Node<D> (the contact phase's nodal forces):
+	// f(k, kp, axis) for every (material-side node k, partner kp) of every symmetry plane, in plane order,
+	// k == kp on the plane. Serial (call from one thread).
+	template <class F>
+	void forEachMirrorPair(F&& f) const
+	{
+		for (const auto& m : mirrors)
+			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * stride[m.axis], col + size_t(kp) * stride[m.axis], m.axis); });
+	}
+	// Share of node i in the modelled region: 0 for a node beyond a symmetry plane (an image), 1/2 for each
+	// symmetry plane it lies on (its content includes the reflected half), else 1. Reactions on bodies sum
+	// nodal forces with this weight.
+	Real mirrorShare(size_t i) const
+	{
+		Real       s = 1;
+		const IVec c = coords(i);
+		for (const auto& m : mirrors) {
+			const int d2 = m.side * (2 * c[m.axis] - m.twoP);
+			if (d2 > 0) return 0;
+			if (d2 == 0) s *= 0.5;
+		}
+		return s;
+	}
 	static NodeLanes allLanes()
 	{
 		NodeLanes l;

@@ -248,6 +248,14 @@ public:
 					}
 				}
 			}
+			// symmetry planes: a node next to a plane also carries the contact of the particles' images
+			if (grid.hasMirrors()) {
+#pragma omp single
+				grid.forEachMirrorPair([&](size_t k, size_t kp, int axis) {
+					for (int a = 0; a < D; ++a) A.fn[a][k] += (a == axis ? -1 : 1) * A.fn[a][kp];
+					A.load[k] += A.load[kp], A.area[k] += A.area[kp];
+				});
+			}
 			// 2. stick / slip per node, Eqs. 24–26
 			const Real mu = g.params.mu, coh = g.params.cohesion;
 			const bool onePart = g.parts.size() == 1;
@@ -284,6 +292,7 @@ public:
 					const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
 					Vec          f;
 					for (int a = 0; a < D; ++a) f[a] = A.force[a][i];
+					if (grid.hasMirrors()) f *= grid.mirrorShare(i); // images beyond symmetry planes are not the body's
 					if (f.isZero(0)) continue;
 					const Vec xi = grid.position(i);
 					auto&     q  = parts[onePart ? g.parts[0] : g.query(xi).part];

@@ -521,13 +521,6 @@ struct SolverWrap {
 	}
 	static bool contactActive(S& s) { return s.contact.active(); }
 
-	// Exclusion bits of every stored node (copy): 1 ghost, 2 beyond a one-sided plane, 4 thin gap/user, 8 contact.
-	static np::ndarray nodeExclusion(S& s)
-	{
-		np::ndarray out = np::empty(bp::make_tuple(s.grid.size()), np::dtype::get_builtin<uint8_t>());
-		std::copy(s.grid.excluded.begin(), s.grid.excluded.end(), reinterpret_cast<uint8_t*>(out.get_data()));
-		return out;
-	}
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
 	static void expose(const char* name)
@@ -581,7 +574,6 @@ struct SolverWrap {
 		        .def("contactNodeForces", &contactNodeForces)
 		        .def("excludedNodes", &excludedNodes)
 		        .add_property("contactActive", &contactActive)
-		        .def("nodeExclusion", &nodeExclusion)
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("requestSort", &S::requestSort)
@@ -687,6 +679,10 @@ BOOST_PYTHON_MODULE(_core)
 	bp::scope().attr("MpmSimulationError") = bp::handle<>(bp::borrowed(simulationErrorType));
 	bp::register_exception_translator<InputError>(&translateInput);
 	bp::register_exception_translator<SimulationError>(&translateSimulation);
+	// Node exclusion bits (Grid.hpp; Solver.excludedNodes() returns them per stored node)
+	bp::dict bits;
+	bits["ghost"] = int(ExGhost), bits["beyond"] = int(ExBeyond), bits["gap"] = int(ExGap), bits["contact"] = int(ExContact);
+	bp::scope().attr("exclusionBits") = bits;
 
 	// Materials: properties, keyword constructors, toDict/fromDict generated from MaterialParams.hpp.
 	using EB = ParamBinding<ElasticMat>;

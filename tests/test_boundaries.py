@@ -6,6 +6,7 @@ import yade_mpm as ym
 from helpers import set_velocity
 
 MAT = ym.rocks.GRANITE
+GAP = ym._core.exclusionBits["gap"]
 
 
 def _block_on_plane(dim, axis, side, kind="slip", cells=6, h=0.1, sigma=-40e6, steps=80):
@@ -146,20 +147,20 @@ def _crack(h, c, gap_nodes="excluded", size=1.2):
 def test_thin_gap_nodes_are_the_crack_midline_only():
     h, c = 0.05, 0.2
     s, xc = _crack(h, c)
-    gap = np.nonzero(s.nodeExclusion() & 4)[0]
+    gap = np.nonzero(s.excludedNodes() & GAP)[0]
     xn = s.nodePositions()[gap]
     # the nodes strictly between the faces: mid-line, |x − xc| < c (tips on node lines here)
     np.testing.assert_allclose(xn[:, 1], xc, atol=1e-12)
     np.testing.assert_allclose(np.sort(xn[:, 0]), xc + h * np.arange(-3, 4), atol=1e-12)
     s2, _ = _crack(h, c, gap_nodes="shared")
-    assert not np.any(s2.nodeExclusion() & 4)
+    assert not np.any(s2.excludedNodes() & GAP)
     # a hole wider than the kernel (radius 2.5 cells) and a big opening keep all their nodes
     s3 = ym.make_solver((0, 0), (1, 1), 0.04)
     ym.add_region(s3, ym.ElasticMat(**MAT), (0, 0), (1, 1), holes=[ym.Circle((0.52, 0.52), 0.1)])
-    assert not np.any(s3.nodeExclusion() & 4)
+    assert not np.any(s3.excludedNodes() & GAP)
     s4 = ym.make_solver((0, 0), (0.15, 0.15), 0.003)
     ym.add_region(s4, ym.ElasticMat(**MAT), (0, 0), (0.15, 0.15), holes=ym.cases.arch_tunnel_holes())
-    assert not np.any(s4.nodeExclusion() & 4)
+    assert not np.any(s4.excludedNodes() & GAP)
 
 
 @pytest.mark.parametrize("width,angle,tied", [(2.0, 0.0, True), (1.5, 0.5, True), (3.0, 0.5, True), (2.0, np.pi / 4, True),
@@ -171,7 +172,7 @@ def test_points_inside_a_thin_gap_keep_a_valid_fit(width, angle, tied):
     s = ym.make_solver((0, 0), (1.2, 1.2), h)
     flaw = ym.rotated_rectangle((0.6, 0.6), 0.5, width * h, angle)
     ym.add_region(s, ym.ElasticMat(**MAT), (0, 0), (1.2, 1.2), holes=[flaw])
-    assert np.any(s.nodeExclusion() & 4) == tied
+    assert np.any(s.excludedNodes() & GAP) == tied
     xn = s.nodePositions()
     rng = np.random.default_rng(1)
     pts = rng.uniform(0.3, 0.9, size=(4000, 2))

@@ -205,8 +205,9 @@ def test_nodes_covered_by_a_body_are_excluded_and_released():
     s.step()
     ex = s.excludedNodes()
     inside = (X[:, 1] < -1e-12) & (X[:, 1] > -0.05) & (X[:, 0] > 0.01) & (X[:, 0] < 0.39)
-    assert np.all(ex[inside] & 2)                        # covered by the wall: contact bit
-    assert not np.any(ex[X[:, 1] > 1e-12] & 2)           # above it: active
+    bit = ym._core.exclusionBits["contact"]
+    assert np.all(ex[inside] & bit)                      # covered by the wall: contact bit
+    assert not np.any(ex[X[:, 1] > 1e-12] & bit)         # above it: active
 
 
 # ---------------------------------------------------------------- YADE bodies (the adapter)

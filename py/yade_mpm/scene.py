@@ -117,7 +117,7 @@ def thin_gap_nodes(solver, lo, hi, dp, holes):
 def _refill_gaps(solver, dp):
     """Gap nodes that particles added since now cover (a filled flaw) take part in the fits again."""
     from scipy.spatial import cKDTree
-    gap = np.nonzero(solver.nodeExclusion() & 4)[0]
+    gap = np.nonzero(solver.excludedNodes() & _core.exclusionBits["gap"])[0]
     if len(gap) == 0:
         return
     d = dim_of(solver)
