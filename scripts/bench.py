@@ -197,15 +197,18 @@ def run_hook_probe(name, steps, warmup):
 
 # The spheres case (issue 12): the dpgk2d_80k scene through O.run, without and with 10⁴ DEM spheres
 # away from the MPM block, registered with yade_mpm.DemSpheres (two-way PTS contact, broad phase).
-SPHERES = dict(base="dpgk2d_80k", n=10_000, radius=0.01, steps=200, quick_steps=60, warmup=10, blocks=3)
+# Layouts: "free" — the spheres sit still on a lattice 1 m beside the block, touching nothing (no gravity on
+# them): YADE's own cost is its collider and NewtonIntegrator, so the ratio shows the coupling's cost;
+# "resting" — one row lying on a floor wall under gravity: YADE also runs 10⁴ sphere–wall contacts.
+SPHERES = dict(base="dpgk2d_80k", n=10_000, radius=0.01, steps=200, quick_steps=60, warmup=10, blocks=3,
+               layouts=("free", "resting"))
 
 
 def run_spheres(name, steps, warmup):
     """Child process: two YADE scenes in this one process (O.switchScene), the same MPM block in each;
-    scene B also holds SPHERES['n'] spheres resting in one row on a floor wall 1 m beside the block
-    (YADE's collider, sphere–wall contacts and NewtonIntegrator run for them; all registered for MPM
-    contact). Interleaved timed blocks; returns the wall seconds per block of each scene."""
-    import numpy as np
+    scene B also holds SPHERES['n'] spheres 1 m beside the block, laid out as `name` ('free' or
+    'resting', see SPHERES), all registered for MPM contact. Interleaved timed blocks; returns the wall
+    seconds per block of each scene."""
     import yade_mpm as ym
     from yade import O, utils
     from yade.wrapper import (ForceResetter, FrictMat, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Wall_Aabb,
@@ -214,12 +217,14 @@ def run_spheres(name, steps, warmup):
     dim, material, cells, _, _ = CASES[SPHERES["base"]]
     r, n = SPHERES["radius"], SPHERES["n"]
 
+    resting = name == "resting"
+
     def engines(s, label, bodies):
         dem = [InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
                InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
                                [Law2_ScGeom_FrictPhys_CundallStrack()])] if bodies else []
         return [ForceResetter()] + dem + [ym.MpmEngine(s, label=label, bodies=bodies).runner(),
-                                          NewtonIntegrator(gravity=(0, -9.81, 0), damping=0.3)]
+                                          NewtonIntegrator(gravity=(0, -9.81 if resting else 0.0, 0), damping=0.3)]
     a = build_scene(dim, material, cells)
     O.engines = engines(a, "mpmNoSpheres", None)
     O.dt = 1.0
@@ -228,9 +233,11 @@ def run_spheres(name, steps, warmup):
     b = build_scene(dim, material, cells)
     x0 = cells[0] * SPACING + 1.0
     mat = O.materials.append(FrictMat(young=1e8, density=2500.0, frictionAngle=0.5))
-    O.bodies.append(utils.wall(0.0, axis=1, material=mat))
-    for k in range(n):   # one row of spheres touching the floor, 0.5 r apart
-        sp = utils.sphere((x0 + 2.5 * r * k, r, 0.0), r, material=mat)
+    if resting:
+        O.bodies.append(utils.wall(0.0, axis=1, material=mat))
+    for k in range(n):   # resting: one row on the floor, 0.5 r apart; free: a 100 × 100 lattice, 0.5 r gaps
+        c = (x0 + 2.5 * r * k, r, 0.0) if resting else (x0 + 2.5 * r * (k % 100), 2 * r + 2.5 * r * (k // 100), 0.0)
+        sp = utils.sphere(c, r, material=mat)
         sp.state.blockedDOFs = "zXY"
         O.bodies.append(sp)
     bodies = ym.DemSpheres(b)
@@ -247,7 +254,7 @@ def run_spheres(name, steps, warmup):
             times.append(time.perf_counter() - t0)
             O.switchScene()
     O.switchScene()
-    return dict(particles=a.numParticles, spheres=n, steps=steps, wall_without=ta, wall_with=tb,
+    return dict(layout=name, particles=a.numParticles, spheres=n, steps=steps, wall_without=ta, wall_with=tb,
                 active_spheres=int(bodies.active.sum()), broad_phase_checks=bodies.checks, coupling_python_wall=bodies.wall,
                 steps_with=b.steps, dt=b.lastDt, threads=ym.getThreads())
 
@@ -410,18 +417,18 @@ def main():
               f"({', '.join(f'{100 * v:.2f} % of a {c} step with {t}T' for t, v in pr['fraction_of_step'].items())})", flush=True)
     spheres = []
     if args.spheres:
-        for t in threads:
+        for t, layout in [(t, lay) for t in threads for lay in SPHERES["layouts"]]:
             steps = SPHERES["quick_steps"] if args.quick else SPHERES["steps"]
-            r = spawn("spheres", "spheres", t, steps, SPHERES["warmup"])
+            r = spawn(layout, "spheres", t, steps, SPHERES["warmup"])
             wa, wb = statistics.median(r["wall_without"]), statistics.median(r["wall_with"])
-            row = dict(case=f"{SPHERES['base']} + {r['spheres']} spheres", threads=t, particles=r["particles"], spheres=r["spheres"],
+            row = dict(case=f"{SPHERES['base']} + {r['spheres']} spheres ({layout})", layout=layout, threads=t, particles=r["particles"], spheres=r["spheres"],
                        rate_without=r["particles"] * steps / wa, rate_with=r["particles"] * steps / wb, ratio=wa / wb,
                        wall_without=r["wall_without"], wall_with=r["wall_with"], active_spheres=r["active_spheres"],
                        broad_phase_checks=r["broad_phase_checks"], steps_with=r["steps_with"],
                        coupling_python_s_per_step=r["coupling_python_wall"] / r["steps_with"],
                        step_s_with=wb / steps)
             spheres.append(row)
-            print(f"[bench] spheres {t}T: {row['rate_with'] / 1e6:.2f} M p-steps/s with {r['spheres']} DEM spheres vs "
+            print(f"[bench] spheres ({layout}) {t}T: {row['rate_with'] / 1e6:.2f} M p-steps/s with {r['spheres']} DEM spheres vs "
                   f"{row['rate_without'] / 1e6:.2f} M without → ratio {row['ratio']:.3f} ({row['active_spheres']} active, "
                   f"{row['broad_phase_checks']} broad-phase checks in {row['steps_with']} steps; Python side of the coupling "
                   f"{1e6 * row['coupling_python_s_per_step']:.0f} µs per step = "

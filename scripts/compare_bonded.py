@@ -1,29 +1,35 @@
 """yade-mpm side by side with YADE's bonded-particle rock model JCFpm (Scholtès & Donzé 2012).
 
 1. Uniaxial compression of the paper's Sec. 3.3 specimen (50 × 150 mm, Miao et al. 2018 sandstone),
-   intact and with the 25 × 2 mm open flaw at 30°, between frictionless platens moving together at
-   --platen-speed:
-   - MPM: 2D plane strain WLS-MPM with DP–GK damage (yade_mpm.cases uniaxial builder, rigid platens
-     through PTS contact), grid spacing --mpm-spacing.
+   intact and with the 25 × 2 mm open flaw at 30°, between two frictionless YADE walls; the top one
+   closes at --platen-speed, reached by a linear ramp over 1 ms; local damping 0.4 on both sides:
+   - MPM: 2D plane strain WLS-MPM with DP–GK damage, the walls through PTS contact (RigidBodies, μ = 0),
+     grid spacing --mpm-spacing, ppc = 2; end caps: no tensile damage within 3 cells of a platen
+     (--capped-ends; without them the layer under the penalty contact cracks first).
    - JCFpm: a layer of bonded spheres, centres at z = 0, motion restricted to the plane
      (yade_mpm.bonded; plane strain: ε_zz = 0 exactly), mean radius --dem-radius, thickness mapping
      t = 2 r̄ (stress = platen force / (W t)).
-   "E" on both sides is the apparent plane-strain modulus Δσ_yy/Δε_yy of the test (slope between 10 %
-   and 50 % of the peak, platen displacement / specimen height); for the elastic MPM rock it is
-   E/(1 − ν²). JCFpm micro-parameters are calibrated on the intact specimen to the MPM's E and peak
-   stress (fixed-point scaling: young ← young·E_mpm/E, tensile and cohesion ← ·σ_mpm/σ, ks/kn = 0.3,
-   cohesion/tensile = 4, contact friction φ = 38°, until both are within --calib-tol), then used
-   unchanged on the flawed specimen.
-2. Circular opening (paper Sec. 3.1 loads) against Kirsch: stress error vs wall time for both methods
-   on one plot. MPM: scripts/circular_opening.py (its convergence table) on an --kirsch-domain block;
-   JCFpm: unbreakable bonds, far-field forces on the edge spheres, Love–Weber stress in windows of
-   radius a/2 along the two lines (Kirsch averaged over the same windows), several sphere sizes.
+   "E" on both sides is the apparent plane-strain modulus Δσ_yy/Δε_yy of the test (slope of the first
+   rise between 25 % and 50 % of the peak, platen displacement / specimen height); for the elastic MPM
+   rock it is E/(1 − ν²). Peak = the largest stress up to the strain cap (--max-strain for MPM,
+   --dem-max-strain for JCFpm). JCFpm micro-parameters are calibrated on the intact specimen to the
+   MPM's E and peak (fixed-point scaling: young ← young·E_mpm/E, tensile and cohesion ← ·σ_mpm/σ,
+   ks/kn = 0.3, cohesion/tensile = 4, contact friction φ = 38°, until both are within --calib-tol),
+   then used unchanged on the flawed specimen.
+2. Circular opening (paper Sec. 3.1 loads) against Kirsch: stress error vs run time (CPU seconds, one
+   thread) for both methods on one plot. MPM: scripts/circular_opening.py at 2l, 1.5l, l on an
+   --kirsch-domain block; JCFpm: unbreakable bonds, far-field forces on the edge spheres, Love–Weber
+   stress in windows of radius a/2 along the two lines (Kirsch averaged over the same windows),
+   several sphere sizes.
 
-Outputs in --out: summary.json, calibration.csv, curves_*.csv, stress_strain.png, cracks_intact.png,
-cracks_open_flaw.png, kirsch_error_vs_time.png, kirsch_*.csv.
+Outputs in --out: summary.json ({intact, open_flaw: {mpm, jcfpm: {youngs_modulus_GPa, peak_stress_MPa,
+particles, wall_time_s, cpu_time_s, ...}}, kirsch: [{method, wall_time_s, cpu_time_s, l2_rel_error_max,
+...}], calibration}), calibration.csv, curves_*.csv, stress_strain.png, cracks_intact.png,
+cracks_open_flaw.png, kirsch_error_vs_time.png/.csv. Results and discussion: doc/mpm_vs_bonded.md.
 
     PYTHONPATH=py OMP_NUM_THREADS=1 /usr/bin/python3 scripts/compare_bonded.py --out out/compare_bonded
     ... --parts kirsch          # one part only (uniaxial, kirsch)
+    ... --parts mpm_intact & ... --parts mpm_open_flaw; ... --parts uniaxial --reuse-mpm   # MPM in parallel
 """
 import argparse
 import csv
