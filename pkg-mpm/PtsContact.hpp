@@ -322,7 +322,7 @@ private:
 		const size_t n = grid.size();
 		if (nodeArr.size() == n) return;
 		nodeArr.resize(n);
-		marked.reserve(1024);
+		marked.reserve(4096);
 	}
 	// Stored coordinates of the physical nodes within [lo, hi]; false when empty.
 	static bool nodeRange(const Grid<D>& grid, const Vec& lo, const Vec& hi, IVec& nlo, IVec& nhi)

@@ -278,6 +278,7 @@ struct SolverWrap {
 		d["sort"]   = s.phase.sort;
 		d["p2g"]    = s.phase.p2g;
 		d["grid"]   = s.phase.grid;
+		d["contact"] = s.phase.contact;
 		d["g2p"]    = s.phase.g2p;
 		d["stress"] = s.phase.stress;
 		return d;

@@ -259,8 +259,24 @@ def run_spheres(name, steps, warmup):
                 steps_with=b.steps, dt=b.lastDt, threads=ym.getThreads())
 
 
+# Contact cost: the uniaxial specimen of paper Sec. 3.3 (cases.uniaxial_flaw, l = 1 mm, rigid-filled flaw:
+# a platen and a free filler in PTS contact) through YADE's loop, beside the same particles without bodies.
+CONTACT_CASE = dict(name="uniaxial_filled_1mm", spacing=1e-3, steps=300, warmup=30)
+
+
+def run_contact(name, steps, warmup):
+    """Child process: O.run of the uniaxial specimen with its platen and filler (mode "contact") or of the
+    same particles without any body ("nocontact")."""
+    from yade import O
+    from yade_mpm import cases
+    bodies = name == "contact"
+    return timed(lambda: cases.uniaxial_flaw("filled", CONTACT_CASE["spacing"], mu_con=0.4, label="mpmcontact",
+                                             with_bodies=bodies)[0], steps, warmup, advance=lambda n: O.run(n, True))[0]
+
+
 def child(args):
-    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe, "spheres": run_spheres}.get(args.mode, run_direct)
+    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe, "spheres": run_spheres,
+          "contact": run_contact}.get(args.mode, run_direct)
     res = fn(args.case, args.steps, args.warmup)
     print("BENCH " + json.dumps(res), flush=True)
 
@@ -289,7 +305,7 @@ def summarise(case, runs):
     rep = min(runs, key=lambda r: abs(r["particles"] * r["steps"] / r["wall"] - med))
     n, st = rep["particles"], rep["steps"]
     phases = {k: v / (n * st) * 1e9 for k, v in rep["phases"].items()}  # ns per particle-step
-    phases["contact"] = 0.0  # rigid-body contact is not implemented yet (its slot sits between grid and G2P)
+    phases.setdefault("contact", 0.0)  # no bodies in these scenes: the contact phase is skipped
     cpu_rates = [r["particles"] * r["steps"] / r["cpu"] for r in runs if r.get("cpu")]
     row = dict(case=case, dim=dim, material=material, contact=False, particles=n, threads=rep["threads"],
                particle_steps_per_s=med, ns_per_particle_step=1e9 / med,
@@ -342,6 +358,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="fewer steps and repeats (smoke test)")
     ap.add_argument("--no-hook", action="store_true", help="skip the YADE O.run comparison")
+    ap.add_argument("--no-contact", action="store_true", help="skip the contact case (uniaxial specimen with platen and "
+                    "filler vs the same particles without bodies)")
     ap.add_argument("--paper", action="store_true", help="also time the paper-scale penny crack (250 k) and tunnel (83 k) "
                     "scenes and extrapolate their full wall time")
     ap.add_argument("--wait-policy", choices=["active", "passive", "inherit"], default="inherit",
@@ -433,6 +451,22 @@ def main():
                   f"{row['broad_phase_checks']} broad-phase checks in {row['steps_with']} steps; Python side of the coupling "
                   f"{1e6 * row['coupling_python_s_per_step']:.0f} µs per step = "
                   f"{100 * row['coupling_python_s_per_step'] / row['step_s_with']:.1f} % of a step)", flush=True)
+    contact = []
+    if not args.no_contact:
+        steps, warm = (50, 5) if args.quick else (CONTACT_CASE["steps"], CONTACT_CASE["warmup"])
+        for t in threads:
+            with_b, without = [], []
+            for _ in range(repeats):  # paired, alternating runs: host noise hits both alike
+                w = spawn("contact", "contact", t, steps, warm)
+                n = spawn("nocontact", "contact", t, steps, warm)
+                with_b.append(w["particles"] * w["steps"] / w["wall"])
+                without.append(n["particles"] * n["steps"] / n["wall"])
+            ratio = statistics.median([a / b for a, b in zip(with_b, without)])
+            contact.append(dict(case=CONTACT_CASE["name"], threads=t, particles=w["particles"], with_bodies_rate=statistics.median(with_b),
+                                without_bodies_rate=statistics.median(without), ratio=ratio, ratios=[a / b for a, b in zip(with_b, without)],
+                                contact_phase_s_per_step=w["phases"].get("contact", float("nan")) / w["steps"]))
+            print(f"[bench] contact {CONTACT_CASE['name']} {t}T: {statistics.median(with_b) / 1e6:.2f} vs {statistics.median(without) / 1e6:.2f} "
+                  f"M p-steps/s without bodies: ratio {ratio:.3f} (bar ≥ 0.70)", flush=True)
     paper = []
     if args.paper:
         for name, cfg in PAPER.items():
@@ -449,7 +483,7 @@ def main():
                                   plastic_fraction=r.get("plastic_fraction"), damaged_fraction=r.get("damaged_fraction")))
                 print(f"[bench] {name} ({r['particles']:,} particles, {t}T, C = {courant}): {rate / 1e6:.2f} M p-steps/s, "
                       f"{n:,.0f} steps → {n * r['particles'] / rate / 60:.1f} min (extrapolated)", flush=True)
-    summary = dict(cases=rows, hook=hooks, paper=paper, spheres=spheres, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
+    summary = dict(cases=rows, hook=hooks, contact=contact, paper=paper, spheres=spheres, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
                    gomp_spincount=os.environ.get("GOMP_SPINCOUNT", "10000 (yade_mpm default)"),
                    load_average_before=load_before, load_average_after=os.getloadavg(),
@@ -462,6 +496,10 @@ def main():
     tab += (f"\n- Host during the run: load average {load_before[0]:.1f} before, {os.getloadavg()[0]:.1f} after; a busy "
             f"process got {probe[1]:.2f} CPUs, two got {probe[2]:.2f} CPUs together (idle host: 1.0 and 2.0); "
             f"OMP_WAIT_POLICY = {summary['omp_wait_policy']}")
+    if contact:
+        tab += "\n\n| contact case | particles | threads | M p-steps/s with platen + filler | without bodies | ratio (bar ≥ 0.70) |\n|---|---|---|---|---|---|\n"
+        tab += "\n".join(f"| {c['case']} | {c['particles']:,} | {c['threads']} | {c['with_bodies_rate'] / 1e6:.2f} | "
+                          f"{c['without_bodies_rate'] / 1e6:.2f} | {c['ratio']:.3f} |" for c in contact)
     if paper:
         tab += "\n\n| paper-scale scene | particles | threads | Courant C | Δt [µs] | steps to end time | M p-steps/s (measured) | wall time (extrapolated) |\n|---|---|---|---|---|---|---|---|\n"
         tab += "\n".join(f"| {p['case']} ({p['end_time'] * 1e3:g} ms) | {p['particles']:,} | {p['threads']} | {p['courant']} | {p['dt'] * 1e6:.3f} | "

@@ -305,3 +305,31 @@ def test_bad_contact_input_is_refused_naming_it():
     with pytest.raises(ValueError, match="chi"):
         s.addContactGroup([s.addRigidPart()], 0.0, 0.0, 1.0, None)
     assert not s.contactActive                       # nothing was registered by the refused calls
+
+
+def test_uniaxial_builder_places_platen_and_filler():
+    """cases.uniaxial_flaw (paper Sec. 3.3): the platen's lower face on the specimen top, the filler a
+    free body inside the flaw (its centre inside the body, the nodes it covers excluded), the top
+    particle row at the detection distance; an unknown variant is refused."""
+    from yade import O
+    from yade_mpm import cases
+    s, sc = cases.uniaxial_flaw("filled", 0.002, mu_con=0.4)
+    W, H = sc["width"], sc["height"]
+    platen, filler = O.bodies[sc["platen"]], O.bodies[sc["filler"]]
+    assert platen.state.pos[1] - platen.shape.extents[1] == pytest.approx(H)
+    assert platen.state.blockedDOFs == "xyzXYZ" and platen.state.vel[1] == pytest.approx(-0.1)
+    assert filler.state.blockedDOFs == "zXY"
+    c = sc["flaw"]["center"]
+    assert np.hypot(filler.state.pos[0] - c[0], filler.state.pos[1] - c[1]) < 1e-12
+    d, n, part = s.contactQuery(1, tuple(c))       # group 1: the filler
+    assert d < 0
+    O.step()
+    ex = s.excludedNodes()
+    X = s.nodePositions()
+    inside = np.array([s.contactQuery(1, tuple(x))[0] < 0 for x in X[np.abs(X[:, 1] - c[1]) < 0.01]])
+    assert np.all(ex[np.abs(X[:, 1] - c[1]) < 0.01][inside] & 2)
+    top = ym.get(s, "pos")[:, 1].max()
+    assert H - top == pytest.approx(0.5 * s.spacing / 2)   # d0 = half the particle edge
+    assert sc["axial_stress"]() >= 0 and sc["axial_strain"]() > 0
+    with pytest.raises(ValueError, match="variant"):
+        cases.uniaxial_flaw("cracked", 0.002)

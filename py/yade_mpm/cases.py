@@ -7,6 +7,8 @@ scenes here and keep only their command line and analysis.
     tunnel_flaw(...)                 paper Sec. 4: the 60 × 2 mm flaw left of the tunnel (geometry only)
     arch_tunnel_specimen(spacing, ...)  the tunnel specimen with its opening and slip walls (no top load)
     arch_tunnel(case, spacing, ...)  paper Sec. 4 + grout: the full scene with the YADE platen (and filler)
+    uniaxial_flaw(variant, spacing, ...)  paper Sec. 3.3: 50 × 150 mm specimen, platen, open/rigid-filled flaw
+    yade_platen / yade_filler / yade_engines   the rigid YADE bodies and engines of those loading scenes
 
 Rock parameters come from ``yade_mpm.rocks``; the small scenes of the stability suite live with their
 checks in ``yade_mpm.stability``. Quantities are SI; stresses are tension positive inside the solver.
@@ -187,10 +189,8 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
                          "cut at least one full particle row, particle spacing l/2)")
     if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
         raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
-    from yade import O, utils
-    from yade.wrapper import ForceResetter, NewtonIntegrator
+    from yade import O
     from .bodies import RigidBodies
-    from .engine import MpmEngine
 
     W = TUNNEL_WIDTH
     flaw = tunnel_flaw() if case != "intact" else None
@@ -200,28 +200,59 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     if case == "grout_flaw":
         add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
     O.reset()
-    thick = 0.5                                    # YADE box half-extent along z: 1 m thick, the 2D unit slice
-    hp = 5 * spacing                               # platen half-height
-    platen = O.bodies.append(utils.box((W / 2, W + hp, 0), (0.6 * W, hp, thick), fixed=False))
-    O.bodies[platen].state.blockedDOFs = "xyzXYZ"
-    O.bodies[platen].state.vel = (0, -platen_speed, 0)
     rb = RigidBodies(s)
-    rb.add(platen, mu=platen_friction)
-    filler = None
-    if case == "filled_flaw":
-        hl, hw = _filler_half_sizes(s, flaw, ppc)
-        ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
-        from yade.minieigenHP import Quaternion, Vector3
-        from yade.wrapper import FrictMat
-        fmat = O.materials.append(FrictMat(density=rock.density, label="filler"))   # the filler weighs as the rock
-        filler = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, thick),
-                                           orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, material=fmat))
-        O.bodies[filler].state.blockedDOFs = "zXY"  # in the plane: x, y, rotation about z
-        rb.add(filler, mu=filler_friction)
-    eng = MpmEngine(s, label=label, bodies=rb)
-    O.engines = [ForceResetter(), eng.runner(), NewtonIntegrator(damping=0.0, gravity=(0, 0, 0))]
-    O.dt = 1.0                                     # lowered to the MPM stable step by the engine
+    platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction)
+    filler = yade_filler(rb, flaw, ppc, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
+    eng = yade_engines(s, rb, label)
     return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W)
+
+
+# ------------------------------------------------------------------------------------------------
+# Rigid YADE bodies of the loading scenes (2D: 1 m thick boxes, the unit slice of plane strain)
+BODY_HALF_THICKNESS = 0.5          # YADE box half-extent along z [m]: thickness 1 m
+
+
+def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0):
+    """A rigid YADE Box platen resting on the specimen top y = `top` [m] (its lower face there: the top
+    particle row is then at the default detection distance, half a particle edge), 1.2 × `width` wide
+    and 10 cells high, blockedDOFs 'xyzXYZ', moving down at `speed` [m/s]; registered in the
+    RigidBodies `rb` with μ = friction [-], c = cohesion [Pa]. Returns its YADE id."""
+    from yade import O, utils
+    hp = 5 * spacing                               # platen half-height
+    pid = O.bodies.append(utils.box((x_center, top + hp, 0), (0.6 * width, hp, BODY_HALF_THICKNESS), fixed=False))
+    O.bodies[pid].state.blockedDOFs = "xyzXYZ"
+    O.bodies[pid].state.vel = (0, -speed, 0)
+    rb.add(pid, mu=friction, cohesion=cohesion)
+    return pid
+
+
+def yade_filler(rb, flaw, ppc, friction, cohesion=0.0, density=None):
+    """A free rigid YADE Box filling the flaw (dict of ``tunnel_flaw``) cut from the particles of
+    rb.solver (``_filler_half_sizes``), free in the plane (blockedDOFs 'zXY'), registered with μ =
+    friction [-], c = cohesion [Pa]; density [kg/m³] (None: YADE's default 1000). Returns its YADE id."""
+    from yade import O, utils
+    from yade.minieigenHP import Quaternion, Vector3
+    from yade.wrapper import FrictMat
+    hl, hw = _filler_half_sizes(rb.solver, flaw, ppc)
+    ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
+    kw = {} if density is None else dict(material=FrictMat(density=density))
+    fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, BODY_HALF_THICKNESS),
+                                    orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, **kw))
+    O.bodies[fid].state.blockedDOFs = "zXY"        # in the plane: x, y, rotation about z
+    rb.add(fid, mu=friction, cohesion=cohesion)
+    return fid
+
+
+def yade_engines(solver, rb, label):
+    """O.engines = [ForceResetter, the MpmEngine (with the RigidBodies `rb`, or None), NewtonIntegrator
+    (no damping, no gravity)]; O.dt is lowered to the MPM stable step by the engine. Returns the MpmEngine."""
+    from yade import O
+    from yade.wrapper import ForceResetter, NewtonIntegrator
+    from .engine import MpmEngine
+    eng = MpmEngine(solver, label=label, bodies=rb)
+    O.engines = [ForceResetter(), eng.runner(), NewtonIntegrator(damping=0.0, gravity=(0, 0, 0))]
+    O.dt = 1.0
+    return eng
 
 
 def _filler_half_sizes(solver, flaw, ppc):
@@ -279,3 +310,85 @@ def tunnel_opening_distance(points, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect
     d_rect = np.hypot(dx, dy)
     d_arch = np.maximum(np.hypot(p[:, 0] - cx, p[:, 1] - top) - radius, 0.0)
     return np.minimum(d_rect, d_arch)
+
+
+# ------------------------------------------------------------------------------------------------
+# Uniaxial compression with a flaw, paper Sec. 3.3 (Figs. 10-15), Miao et al. (2018) sandstone
+UNIAXIAL_WIDTH = 0.05              # specimen width [m]
+UNIAXIAL_HEIGHT = 0.15             # specimen height [m]
+UNIAXIAL_FLAW = (0.025, 0.002, math.radians(30.0))   # flaw length, width [m], inclination [rad], at the centre
+UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
+UNIAXIAL_VARIANTS = ("intact", "open", "filled")
+UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face [m]: spalled fragments (measured up to 14 m/s) stay on the grid
+
+
+def uniaxial_flaw_geometry(width=UNIAXIAL_WIDTH, height=UNIAXIAL_HEIGHT, flaw=UNIAXIAL_FLAW):
+    """The centred flaw as a dict like ``tunnel_flaw`` (toe, tip, centre, direction, normal, polygon…)."""
+    length, fw, angle = flaw
+    u = np.array([-math.cos(angle), math.sin(angle)])
+    center = np.array([width / 2, height / 2])
+    return tunnel_flaw(toe=center - 0.5 * length * u, length=length, width=fw, angle=angle)
+
+
+def exclude_nodes_inside(solver, polygon):
+    """Take the physical grid nodes inside `polygon` out of the WLS fits (user exclusion bit): the
+    faces of an open flaw thinner than the stencil then do not share those nodes — the same nodes a
+    rigid filler of the flaw covers (contact bit). Returns the number of nodes excluded."""
+    xn = solver.nodePositions()
+    lo, hi = np.asarray(solver.origin), np.asarray(solver.origin) + solver.spacing * np.asarray(solver.cells)
+    inside = polygon.contains(xn) & np.all((xn > lo + 1e-12) & (xn < hi - 1e-12), axis=1)
+    for i in np.nonzero(inside)[0]:
+        solver.setNodeExcluded(int(i), True)
+    return int(inside.sum())
+
+
+def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
+                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True):
+    """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
+    ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
+    platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
+    free-slip top), and
+      variant "intact"  no flaw,
+              "open"    the 25 × 2 mm flaw inclined 30° at the centre cut out (nodes inside excluded),
+              "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
+                        contact with μ_con = mu_con [-] and c_con = c_con [Pa].
+    spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
+    the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
+    Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
+    rigid (RigidBodies), engine (MpmEngine), flaw (dict or None), width, height [m],
+    axial_stress() -> platen reaction / width [Pa, compression positive],
+    axial_strain() -> platen displacement / height [-])."""
+    if variant not in UNIAXIAL_VARIANTS:
+        raise ValueError(f"variant = {variant!r} must be one of {UNIAXIAL_VARIANTS}")
+    W, H = UNIAXIAL_WIDTH, UNIAXIAL_HEIGHT
+    flaw = uniaxial_flaw_geometry() if variant != "intact" else None
+    if flaw is not None and not (isinstance(spacing, (int, float)) and 0 < spacing <= 2 * flaw["width"]):
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {2 * flaw['width']}] m: the {flaw['width'] * 1e3:g} mm "
+                         "flaw must cut at least one full particle row")
+    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
+        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    from yade import O
+    from .bodies import RigidBodies
+    rock = material or rocks.miao2018_sandstone()
+    side = UNIAXIAL_SIDE_ROOM                      # grid room beside the free faces for spalled fragments
+    s = make_solver((-side, 0), (W + side, H), spacing, margin=2)
+    add_region(s, rock, (0, 0), (W, H), ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
+    s.addBoundaryPlane(1, -1, 0.0, "slip")
+    if variant == "open":
+        exclude_nodes_inside(s, flaw["polygon"])
+    O.reset()
+    if not with_bodies:
+        return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H)
+    rb = RigidBodies(s)
+    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction)
+    filler = yade_filler(rb, flaw, ppc, mu_con, c_con, density=rock.density) if variant == "filled" else None
+    eng = yade_engines(s, rb, label)
+    y0 = O.bodies[platen].state.pos[1]
+
+    def axial_stress():
+        return rb.force(platen)[1] / W             # the rock pushes the platen up: compression positive
+
+    def axial_strain():
+        return (y0 - O.bodies[platen].state.pos[1]) / H
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H,
+                   axial_stress=axial_stress, axial_strain=axial_strain)

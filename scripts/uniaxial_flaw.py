@@ -1,0 +1,297 @@
+"""Uniaxial compression of a sandstone specimen with an open or rigid-filled flaw (paper Sec. 3.3,
+Figs. 10–15): 50 × 150 mm Miao (2018) sandstone (DP–GK), a 25 × 2 mm flaw inclined 30° at the centre,
+a rigid YADE platen pushed down at 0.1 m/s, free-slip top and bottom. The scene is
+``yade_mpm.cases.uniaxial_flaw``; the filler is a free YADE Box in PTS contact (μ_con, c_con).
+
+Runs (default: all): intact; open flaw; filled flaw with μ_con ∈ {0, 0.2, 0.4, 0.6, 0.8} (c_con = 0) and
+c_con ∈ {0, 1, 5, 10} MPa (μ_con = 0). Each run writes OUT/runs/NAME/: curve.csv (axial strain, axial
+stress = platen reaction / width), particles.pvd + .vtu series, snapshots.npz, run.json. Then the
+summary: OUT/summary.json (`runs`: variant, mu_con, c_con_MPa, peak_stress_MPa, strain_at_peak,
+youngs_modulus_GPa, wall_time_s, particles, steps, particle_steps_per_s), curves.csv, peaks.md,
+curves_mu.png and curves_c.png (with open and intact), damage_plastic_NAME.png at t = 1, 2, 3, 4 ms,
+sigma_max_open_vs_filled.png.
+
+    PYTHONPATH=py /usr/bin/python3 scripts/uniaxial_flaw.py [--out DIR] [--paper | --spacing L]
+        [--runs intact,open,filled:0.4:0] [--end-time T] [--summary-only]
+    yade-batch scripts/uniaxial_flaw.table scripts/uniaxial_flaw.py    # one job per row, same OUT
+"""
+import argparse
+import glob
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+import yade_mpm as ym
+from yade_mpm import cases, output, runner
+
+DEFAULT_SPACING = 2.0e-3       # coarse default grid [m]: the whole set in < 15 min on 2 idle cores
+END_TIME = 0.014               # simulated loading time [s] (1.4 mm of platen travel); runs stop earlier once softened
+SNAP_TIMES = (1e-3, 2e-3, 3e-3, 4e-3)
+MU_SWEEP = (0.0, 0.2, 0.4, 0.6, 0.8)
+C_SWEEP_MPA = (0.0, 1.0, 5.0, 10.0)
+DEFAULT_OUT = "out/uniaxial_flaw"
+
+
+def all_runs():
+    runs = [("intact", 0.0, 0.0), ("open", 0.0, 0.0)]
+    runs += [("filled", mu, 0.0) for mu in MU_SWEEP]
+    runs += [("filled", 0.0, c) for c in C_SWEEP_MPA if c != 0.0]
+    return runs
+
+
+def run_name(variant, mu, c):
+    return variant if variant != "filled" else f"filled_mu{mu:g}_c{c:g}MPa"
+
+
+def parse_runs(text):
+    out = []
+    for item in text.split(","):
+        parts = item.strip().split(":")
+        if parts[0] not in cases.UNIAXIAL_VARIANTS:
+            raise ValueError(f"--runs: variant {parts[0]!r} must be one of {cases.UNIAXIAL_VARIANTS}")
+        mu = float(parts[1]) if len(parts) > 1 else 0.0
+        c = float(parts[2]) if len(parts) > 2 else 0.0
+        out.append((parts[0], mu, c))
+    return out
+
+
+def parse(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", default=DEFAULT_OUT, help="output folder (default %(default)s)")
+    p.add_argument("--paper", action="store_true", help="the paper's grid, 0.5 mm (slow)")
+    p.add_argument("--spacing", type=float, default=None, help=f"grid spacing [m] (default {DEFAULT_SPACING})")
+    p.add_argument("--end-time", type=float, default=END_TIME, help="loading time [s] (default %(default)s)")
+    p.add_argument("--runs", default=None, help="subset, e.g. intact,open,filled:0.4:0 (variant:mu_con:c_con_MPa)")
+    p.add_argument("--vtu-every", type=float, default=1e-3, help="VTU period [s] (default %(default)s)")
+    p.add_argument("--progress", type=float, default=30.0, help="wall seconds between progress lines")
+    p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json into the summary")
+    a = p.parse_args(argv)
+    if a.paper and a.spacing is not None:
+        p.error("--paper and --spacing exclude each other")
+    a.spacing = cases.UNIAXIAL_PAPER_SPACING if a.paper else (a.spacing or DEFAULT_SPACING)
+    if not (a.spacing > 0 and a.end_time > 0 and a.vtu_every > 0):
+        p.error("--spacing, --end-time and --vtu-every must be > 0")
+    a.run_list = parse_runs(a.runs) if a.runs else all_runs()
+    return a
+
+
+# ------------------------------------------------------------------------------------------------ one run
+def one_run(variant, mu, c_mpa, a):
+    from yade import O
+    name = run_name(variant, mu, c_mpa)
+    d = os.path.join(a.out, "runs", name)
+    os.makedirs(d, exist_ok=True)
+    s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"))
+    curve, snaps = [], {}
+
+    def record(solver):
+        curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
+
+    def snapshot(solver):
+        o = ym.id_order(solver)
+        snaps[f"{solver.time:.6e}"] = np.column_stack([ym.get(solver, "pos", o), ym.get(solver, "damage", o),
+                                                       ym.get(solver, "plastic_strain", o),
+                                                       ym.get(solver, "max_principal_stress", o)])
+
+    def softened(solver):       # stop after the peak: stress below 60 % of a peak of ≥ 5 MPa, 20 % later than it
+        if solver.steps % 50:
+            return False
+        st = [q[2] for q in curve]
+        k = int(np.argmax(st))
+        return st[k] > 5e6 and st[-1] < 0.6 * st[k] and solver.time > 1.2 * curve[k][0]
+    series = output.VtuSeries(d)
+    snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})
+    t0 = time.time()
+    res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
+                     outputs=[runner.Output(record, steps=1), runner.Output(snapshot, times=snap_times),
+                              runner.Output(series.write, period=a.vtu_every, at_end=True)])
+    wall = time.time() - t0
+    t, eps, sig = np.array(curve).T
+    output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"],
+                     np.column_stack([t, eps, sig / 1e6]))
+    np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
+    k = int(np.argmax(sig))
+    pre = (sig > 0.1 * sig[k]) & (sig < 0.4 * sig[k]) & (np.arange(len(sig)) < k)
+    E = np.polyfit(eps[pre], sig[pre], 1)[0] if pre.sum() > 3 else float("nan")
+    filler_disp = None
+    if sc["filler"] is not None:
+        p = O.bodies[sc["filler"]].state
+        filler_disp = dict(dx_m=float(p.displ()[0]), dy_m=float(p.displ()[1]), rotation_rad=float(p.rot()[2]))
+    entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
+                 strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
+                 wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
+                 particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
+                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, filler_motion=filler_disp,
+                 damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))
+    with open(os.path.join(d, "run.json"), "w") as f:
+        json.dump(entry, f, indent=1)
+    print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
+          f"{s.steps} steps, {wall:.0f} s, {entry['particle_steps_per_s'] / 1e6:.2f} M particle-steps/s", flush=True)
+    return entry
+
+
+# ------------------------------------------------------------------------------------------------ summary
+def load_runs(out):
+    runs = []
+    for f in sorted(glob.glob(os.path.join(out, "runs", "*", "run.json"))):
+        with open(f) as fh:
+            e = json.load(fh)
+        e["dir"] = os.path.dirname(f)
+        runs.append(e)
+    return runs
+
+
+def _curve(e):
+    c = np.loadtxt(os.path.join(e["dir"], "curve.csv"), delimiter=",", skiprows=1, ndmin=2)
+    return c[:, 1], c[:, 2]
+
+
+def _find(runs, variant, mu=0.0, c=0.0):
+    for e in runs:
+        if e["variant"] == variant and abs(e["mu_con"] - mu) < 1e-9 and abs(e["c_con_MPa"] - c) < 1e-9:
+            return e
+    return None
+
+
+def sweep_png(runs, out, key, values, fname, title):
+    plt = output.pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for v, style in ((_find(runs, "intact"), "k-"), (_find(runs, "open"), "k--")):
+        if v is not None:
+            e, s = _curve(v)
+            ax.plot(e * 1e3, s, style, lw=1.5, label=v["variant"])
+    cmap = plt.get_cmap("viridis")
+    for i, val in enumerate(values):
+        v = _find(runs, "filled", **({"mu": val} if key == "mu" else {"c": val}))
+        if v is None:
+            continue
+        e, s = _curve(v)
+        lab = f"filled, μ_con = {val:g}" if key == "mu" else f"filled, c_con = {val:g} MPa"
+        ax.plot(e * 1e3, s, color=cmap(i / max(1, len(values) - 1)), lw=1.2, label=lab)
+    ax.set_xlabel("axial strain [‰]")
+    ax.set_ylabel("axial stress [MPa]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, fname), dpi=130)
+    plt.close(fig)
+
+
+def _snap(e, t):
+    z = np.load(os.path.join(e["dir"], "snapshots.npz"))
+    keys = sorted(z.files, key=float)
+    k = min(keys, key=lambda q: abs(float(q) - t))
+    return float(k), z[k]
+
+
+def _has_snaps(e):
+    return bool(np.load(os.path.join(e["dir"], "snapshots.npz")).files)
+
+
+def damage_png(e, out):
+    if not _has_snaps(e):
+        return
+    plt = output.pyplot()
+    fig, axs = plt.subplots(2, len(SNAP_TIMES), figsize=(2.2 * len(SNAP_TIMES), 9.5), sharey=True)
+    for j, t in enumerate(SNAP_TIMES):
+        tt, a = _snap(e, t)
+        for i, (col, lab, vmax) in enumerate(((2, "damage D", 1.0), (3, "plastic strain ε̄p", None))):
+            ax = axs[i, j]
+            sc = ax.scatter(a[:, 0] * 1e3, a[:, 1] * 1e3, c=a[:, col], s=1.5, cmap="inferno_r", vmin=0,
+                            vmax=vmax or max(1e-6, a[:, col].max()))
+            ax.set_aspect("equal")
+            ax.set_title(f"{lab}\nt = {tt * 1e3:.1f} ms", fontsize=8)
+            ax.set_xlabel("x [mm]")
+            if j == 0:
+                ax.set_ylabel("y [mm]")
+            fig.colorbar(sc, ax=ax, shrink=0.6)
+    fig.suptitle(f"{os.path.basename(e['dir'])}: damage (top) and plastic strain (bottom)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, f"damage_plastic_{os.path.basename(e['dir'])}.png"), dpi=110)
+    plt.close(fig)
+
+
+def sigma_png(runs, out):
+    op, fi = _find(runs, "open"), _find(runs, "filled", mu=0.4) or _find(runs, "filled")
+    if op is None or fi is None or not (_has_snaps(op) and _has_snaps(fi)):
+        return None
+    plt = output.pyplot()
+    t = op["time_at_peak_s"]
+    fig, axs = plt.subplots(1, 2, figsize=(7, 9), sharey=True)
+    lim = None
+    for ax, e in zip(axs, (op, fi)):
+        tt, a = _snap(e, t)
+        s = a[:, 4] / 1e6             # σ̃max: maximum principal stress carried (damaged), tension positive
+        lim = lim or np.percentile(np.abs(s), 99)
+        sc = ax.scatter(a[:, 0] * 1e3, a[:, 1] * 1e3, c=s, s=1.5, cmap="coolwarm", vmin=-lim, vmax=lim)
+        ax.set_aspect("equal")
+        ax.set_title(f"{os.path.basename(e['dir'])}\nσ̃max at t = {tt * 1e3:.1f} ms [MPa]", fontsize=9)
+        ax.set_xlabel("x [mm]")
+        fig.colorbar(sc, ax=ax, shrink=0.6)
+    axs[0].set_ylabel("y [mm]")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "sigma_max_open_vs_filled.png"), dpi=110)
+    plt.close(fig)
+    return t
+
+
+def summarize(out):
+    runs = load_runs(out)
+    if not runs:
+        print(f"no runs under {out}/runs")
+        return None
+    sweep_png(runs, out, "mu", MU_SWEEP, "curves_mu.png", "filled flaw, c_con = 0 (Fig. 13a-like)")
+    sweep_png(runs, out, "c", C_SWEEP_MPA, "curves_c.png", "filled flaw, μ_con = 0 (Fig. 13b-like)")
+    for e in runs:
+        damage_png(e, out)
+    t_sig = sigma_png(runs, out)
+    keys = ["variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "youngs_modulus_GPa", "wall_time_s",
+            "particles", "steps", "particle_steps_per_s"]
+    order = {"intact": 0, "open": 1, "filled": 2}
+    runs.sort(key=lambda e: (order[e["variant"]], e["c_con_MPa"], e["mu_con"]))
+    rows = [[e[k] for k in keys] for e in runs]
+    output.write_csv(os.path.join(out, "peaks.csv"), keys, rows)
+    with open(os.path.join(out, "peaks.md"), "w") as f:
+        f.write("| variant | μ_con | c_con [MPa] | peak [MPa] | ε at peak | E [GPa] | wall [s] | particles | steps | M p-steps/s |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|\n")
+        for e in runs:
+            f.write(f"| {e['variant']} | {e['mu_con']:g} | {e['c_con_MPa']:g} | {e['peak_stress_MPa']:.2f} | {e['strain_at_peak']:.4f} | "
+                    f"{e['youngs_modulus_GPa']:.2f} | {e['wall_time_s']:.0f} | {e['particles']} | {e['steps']} | "
+                    f"{e['particle_steps_per_s'] / 1e6:.2f} |\n")
+    summary = dict(case="uniaxial compression with a flaw, paper Sec. 3.3", spacing_m=runs[0]["spacing_m"],
+                   sigma_max_time_s=t_sig,
+                   runs=[{k: e[k] for k in keys + ["time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end"]}
+                         for e in runs],
+                   total_wall_time_s=sum(e["wall_time_s"] for e in runs))
+    output.write_summary(out, summary)
+    print(open(os.path.join(out, "peaks.md")).read())
+    return summary
+
+
+def main(argv=None):
+    table = os.environ.get("YADE_BATCH")
+    if table:                                      # a yade-batch job: one row of scripts/uniaxial_flaw.table
+        from yade import utils
+        utils.readParamsFromTable(variant="open", mu_con=0.0, c_con_MPa=0.0, out=DEFAULT_OUT, spacing=DEFAULT_SPACING,
+                                  noTableOk=True)
+        from yade.params import table as row
+        a = parse(["--out", row.out, "--spacing", str(row.spacing)])
+        one_run(row.variant, float(row.mu_con), float(row.c_con_MPa), a)
+        summarize(a.out)                           # rewritten after every job: the last one sees all
+        return
+    a = parse(argv)
+    if not a.summary_only:
+        t0 = time.time()
+        for variant, mu, c in a.run_list:
+            one_run(variant, mu, c, a)
+        print(f"all runs: {time.time() - t0:.0f} s wall")
+    summarize(a.out)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
