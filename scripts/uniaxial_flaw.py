@@ -256,6 +256,11 @@ def summarize(out):
     runs.sort(key=lambda e: (order[e["variant"]], e["c_con_MPa"], e["mu_con"]))
     rows = [[e[k] for k in keys] for e in runs]
     output.write_csv(os.path.join(out, "peaks.csv"), keys, rows)
+    long = []
+    for e in runs:                                 # every curve in one file (every 10th recorded step)
+        eps, sig = _curve(e)
+        long += [[os.path.basename(e["dir"]), a, b] for a, b in zip(eps[::10], sig[::10])]
+    output.write_csv(os.path.join(out, "curves.csv"), ["run", "axial_strain", "axial_stress_MPa"], long)
     with open(os.path.join(out, "peaks.md"), "w") as f:
         f.write("| variant | μ_con | c_con [MPa] | peak [MPa] | ε at peak | E [GPa] | wall [s] | particles | steps | M p-steps/s |\n")
         f.write("|---|---|---|---|---|---|---|---|---|---|\n")
@@ -263,6 +268,11 @@ def summarize(out):
             f.write(f"| {e['variant']} | {e['mu_con']:g} | {e['c_con_MPa']:g} | {e['peak_stress_MPa']:.2f} | {e['strain_at_peak']:.4f} | "
                     f"{e['youngs_modulus_GPa']:.2f} | {e['wall_time_s']:.0f} | {e['particles']} | {e['steps']} | "
                     f"{e['particle_steps_per_s'] / 1e6:.2f} |\n")
+    u = cases.uniaxial_flaw_geometry()["direction"]
+    for e in runs:   # YADE's rot() is measured from refOri = identity: subtract the filler's initial angle
+        fm = e.get("filler_motion")
+        if fm:
+            fm["rotation_change_deg"] = math.degrees(fm["rotation_rad"] - math.atan2(u[1], u[0]))
     summary = dict(case="uniaxial compression with a flaw, paper Sec. 3.3", spacing_m=runs[0]["spacing_m"],
                    sigma_max_time_s=t_sig,
                    runs=[{k: e[k] for k in keys + ["time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end"]}
