@@ -69,6 +69,8 @@ def parse(argv=None):
     p.add_argument("--vtu-every", type=float, default=1e-3, help="VTU period [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=30.0, help="wall seconds between progress lines")
     p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json into the summary")
+    p.add_argument("--filler-blocked-dofs", default="zXY", help="blockedDOFs of the filler (default %(default)s: free in the "
+                   "plane; zXYZ: no rotation)")
     a = p.parse_args(argv)
     if a.paper and a.spacing is not None:
         p.error("--paper and --spacing exclude each other")
@@ -85,7 +87,8 @@ def one_run(variant, mu, c_mpa, a):
     name = run_name(variant, mu, c_mpa)
     d = os.path.join(a.out, "runs", name)
     os.makedirs(d, exist_ok=True)
-    s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"))
+    s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
+                                filler_blocked=a.filler_blocked_dofs)
     curve, snaps = [], {}
 
     def record(solver):

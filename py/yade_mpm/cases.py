@@ -226,10 +226,11 @@ def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0
     return pid
 
 
-def yade_filler(rb, flaw, ppc, friction, cohesion=0.0, density=None):
+def yade_filler(rb, flaw, ppc, friction, cohesion=0.0, density=None, blocked="zXY"):
     """A free rigid YADE Box filling the flaw (dict of ``tunnel_flaw``) cut from the particles of
-    rb.solver (``_filler_half_sizes``), free in the plane (blockedDOFs 'zXY'), registered with μ =
-    friction [-], c = cohesion [Pa]; density [kg/m³] (None: YADE's default 1000). Returns its YADE id."""
+    rb.solver (``_filler_half_sizes``), free in the plane (blockedDOFs `blocked`, default 'zXY'; 'zXYZ'
+    also blocks its rotation), registered with μ = friction [-], c = cohesion [Pa]; density [kg/m³] (None:
+    YADE's default 1000). Returns its YADE id."""
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3
     from yade.wrapper import FrictMat
@@ -238,7 +239,7 @@ def yade_filler(rb, flaw, ppc, friction, cohesion=0.0, density=None):
     kw = {} if density is None else dict(material=FrictMat(density=density))
     fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, BODY_HALF_THICKNESS),
                                     orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, **kw))
-    O.bodies[fid].state.blockedDOFs = "zXY"        # in the plane: x, y, rotation about z
+    O.bodies[fid].state.blockedDOFs = blocked      # default in the plane: x, y, rotation about z
     rb.add(fid, mu=friction, cohesion=cohesion)
     return fid
 
@@ -343,7 +344,7 @@ def exclude_nodes_inside(solver, polygon):
 
 
 def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
-                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True):
+                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY"):
     """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
     ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
@@ -352,6 +353,7 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
               "open"    the 25 × 2 mm flaw inclined 30° at the centre cut out (nodes inside excluded),
               "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
                         contact with μ_con = mu_con [-] and c_con = c_con [Pa].
+    filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/contact.md).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
@@ -381,7 +383,7 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H)
     rb = RigidBodies(s)
     platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction)
-    filler = yade_filler(rb, flaw, ppc, mu_con, c_con, density=rock.density) if variant == "filled" else None
+    filler = yade_filler(rb, flaw, ppc, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
 
