@@ -199,6 +199,32 @@ def test_far_spheres_are_skipped_and_change_nothing():
         np.testing.assert_array_equal(ym.get(a, name), ym.get(b, name))
 
 
+def test_platen_and_sphere_in_one_engine():
+    """RigidBodies (a box platen pressing the left half of the block) and DemSpheres (a sphere resting on
+    the right half) in one MpmEngine: both act — the platen receives the block's push-back, the sphere
+    carries its weight (two-step mean within 2 %)."""
+    from yade import O, utils
+    O.reset()
+    s = _block(floor=True)
+    s.damping = 0.3
+    bid = O.bodies.append(_sphere(0.15, 0.1 + R, 0.0))
+    box = O.bodies.append(utils.box((0.05, 0.1 + 0.02 + 1e-4, 0.0), (0.03, 0.02, 0.05), fixed=True))
+    O.bodies[box].state.vel = (0.0, -0.02, 0.0)
+    rb = ym.RigidBodies(s)
+    rb.add(box)
+    sp = ym.DemSpheres(s, ids=[bid])
+    with pytest.raises(ValueError, match="list of them"):
+        ym.MpmEngine(s, label="mpmBad", bodies=[rb, object()])
+    _run(s, [rb, sp], gravity=-9.81)
+    O.run(1500, True)
+    assert rb.force(box)[1] > 0                       # the block pushes the platen up
+    f = []
+    for _ in range(2):
+        O.step()
+        f.append(sp.force(bid)[1] * sp.thickness(bid))
+    assert np.mean(f) == pytest.approx(O.bodies[bid].state.mass * 9.81, rel=0.02)
+
+
 def test_bad_input():
     from yade import O, utils
     O.reset()

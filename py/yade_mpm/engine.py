@@ -31,12 +31,16 @@ class MpmEngine:
     def __init__(self, solver, label="mpm", progress_interval=None, end_time=None, bodies=None):
         """solver: a Solver2D/3D; label: YADE engine label; progress_interval: wall seconds between
         progress lines (None = silent); end_time: simulated end time [s] for the ETA; bodies: the
-        RigidBodies in contact with the particles (None: no contact code runs)."""
+        RigidBodies or DemSpheres in contact with the particles, or a list of them (rigid platens and
+        DEM spheres in one scene); None: no contact code runs."""
         from .scene import dim_of
         dim_of(solver)                                    # ValueError unless a Solver2D/Solver3D
-        if bodies is not None and getattr(bodies, "solver", None) is not solver:
-            raise ValueError("bodies must be a yade_mpm.RigidBodies built on this engine's solver")
+        adapters = [] if bodies is None else list(bodies) if isinstance(bodies, (list, tuple)) else [bodies]
+        for b in adapters:
+            if getattr(b, "solver", None) is not solver or not (callable(getattr(b, "read", None)) and callable(getattr(b, "write", None))):
+                raise ValueError("bodies must be a yade_mpm.RigidBodies / DemSpheres (or a list of them) built on this engine's solver")
         self.bodies = bodies
+        self._adapters = adapters
         if not isinstance(label, str) or not label.isidentifier():
             raise ValueError(f"label = {label!r} must be a Python identifier (YADE exposes labels as names)")
         self.solver, self.label = solver, label
@@ -79,11 +83,11 @@ class MpmEngine:
             if dt != O.dt:
                 O.dt = dt
             self.last_set_dt = O.dt
-            if self.bodies is not None:
-                self.bodies.read()
+            for b in self._adapters:
+                b.read()
             s.advance(O.dt)
-            if self.bodies is not None:
-                self.bodies.write()
+            for b in self._adapters:
+                b.write()
         except Exception as e:  # stop YADE cleanly with the message instead of stepping on
             self.error = e
             O.pause()
