@@ -108,6 +108,13 @@ class CaseRun:
         self.lattice = analysis.Lattice(self.x0, self.dp, origin=(0, 0))
         self.rock = self._rock_mask()
         self.dist = cases.tunnel_opening_distance(self.x0)
+        fl = self.bodies["flaw"]                              # distance to the flaw (its faces slide: not a band)
+        if fl is None:
+            self.dist_flaw = np.full(len(self.x0), np.inf)
+        else:
+            r = self.x0 - fl["toe"]
+            along = np.clip(r @ fl["direction"], 0, fl["length"])
+            self.dist_flaw = np.linalg.norm(r - along[:, None] * fl["direction"], axis=1)
         from yade import O
         self.platen_y0 = O.bodies[self.bodies["platen"]].state.pos[1]
         # recorder state (saved with each checkpoint)
@@ -226,7 +233,7 @@ class CaseRun:
             return self
         self.state["done"] = res.reason == "end_time"
         self.state["final_displacement"] = self.displacement()
-        self.state["time"] = s.time
+        self.state["time"], self.state["steps"] = s.time, int(s.steps)
         ck.save(s.steps)                                      # the last state: resumable, or the finished run
         with open(done, "w") as f:                            # the recorded state, readable without the build
             json.dump(self.state, f)
@@ -286,7 +293,7 @@ class CaseRun:
             sp = analysis.spalled(failed, self.lattice, opening, f["mass"])
             shear = self.rock & (f["epsP"] >= soft_end)
             # shear bands: localised plastic strain (not the tensile cracks) away from the opening's plastic rim
-            zone = self.rock & (f["damage"] < 1) & (self.dist > BAND_GAP)
+            zone = self.rock & (f["damage"] < 1) & (self.dist > BAND_GAP) & (self.dist_flaw > BAND_GAP)
             ref = float(np.percentile(f["epsP"][zone], 99)) if zone.any() else 0.0
             thr = max(BAND_MIN, BAND_FRACTION * ref)
             bands = analysis.bands(zone & (f["epsP"] >= thr), self.lattice)
@@ -328,7 +335,7 @@ class CaseRun:
         snap = self.result["snapshots"]
         sym_key = "08ms" if "08ms" in snap else (sorted(snap)[-1] if snap else None)
         fc = st["first_crack"]
-        return {"case": self.case, "grid_spacing_m": s.spacing, "particles": int(s.numParticles), "steps": int(s.steps),
+        return {"case": self.case, "grid_spacing_m": s.spacing, "particles": int(s.numParticles), "steps": int(st.get("steps", s.steps)),
                 "wall_time_s": round(st["wall"], 2),
                 "particle_steps_per_s": float(s.numParticles * st["steps_run"] / st["wall"]) if st["wall"] > 0 else None,
                 "final_displacement_mm": d_end * 1e3, "axial_stress_MPa_at": at,
@@ -383,7 +390,7 @@ class CaseRun:
                      f"   {info['spalled_mass_kg_per_m']:.3f} kg per m of tunnel, at: {info['spalling_at'] or '—'}",
                      f"damage symmetry {_fmt(info['symmetry_damage'])}, plastic strain symmetry {_fmt(info['symmetry_plastic'])}",
                      f"D = 1 in {100 * info['damaged_fraction']:.2f} % of the rock",
-                     "shear bands (ε̄p ≥ %.1e, beyond %g mm):" % (info["band_threshold"], BAND_GAP * 1e3)]
+                     "shear bands (ε̄p ≥ %.1e, beyond %g mm of opening and flaw):" % (info["band_threshold"], BAND_GAP * 1e3)]
             lines += [f"   {b['side']}: {abs(b['angle_deg']):.0f}° to the horizontal, {b['length'] * 1e3:.0f} mm, {b['location']}"
                       for b in info["bands"][:5]] or ["   none"]
             if "toe_damaged" in info:
