@@ -25,11 +25,15 @@ import numpy as np
 PARTS = {
     "circular_opening": "/usr/bin/python3 scripts/circular_opening.py --out out/circular_opening --convergence",
     "penny_crack": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack",
+    "penny_crack_damage": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack_damage --parts damage",
     "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
     "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --cases intact",
 }
+
+
+MAX_FIGURE_BYTES = 400_000       # larger pictures stay in the output folder
 
 
 class Report:
@@ -69,12 +73,12 @@ class Report:
         self.w(f"![{caption}]({rel})" if width is None else f'<img src="{rel}" width="{width}" alt="{caption}">', f"*{caption}*", "")
         return True
 
-    def figures(self, part, pattern="*.png", skip=()):
-        for p in sorted(glob.glob(os.path.join(self.folder(part), pattern))):
-            b = os.path.basename(p)
-            if b in skip:
-                continue
-            self.figure(p, f"{part}_{b}", f"{part}: {b}")
+    def figures(self, part, names):
+        """The named PNGs of a part's folder (a selection: doc/ keeps small files only)."""
+        for b in names:
+            for p in sorted(glob.glob(os.path.join(self.folder(part), b))):
+                if os.path.getsize(p) <= MAX_FIGURE_BYTES:
+                    self.figure(p, f"{part}_{os.path.basename(p)}", f"{part}: {os.path.basename(p)}")
 
     def write(self):
         path = os.path.join(self.doc, "validation.md")
@@ -149,14 +153,22 @@ def circular(R):
         f"θ = 90° {fmt(s.get('hoop_stress_theta90_MPa'))} MPa (Kirsch {fmt(s.get('kirsch_hoop_theta90_MPa'))}); "
         f"max L2 relative error of the stress profiles {fmt(s.get('l2_rel_error_max'))}; grid {fmt(s.get('grid_spacing_m'))} m, "
         f"{fmt(s.get('particles'))} particles, wall {fmt(s.get('wall_time_s'))} s.", "")
-    R.figures("circular_opening")
+    R.figures("circular_opening", ["convergence.png", "stress_lines_zoom.png"])
 
 
 def penny(R):
     R.w("## Penny-shaped (line) crack (paper Sec. 3.2, Sneddon)", "")
     s = R.load("penny_crack")
+    if s is not None:
+        if s.get("convergence"):
+            R.w("Elastic opening against Sneddon (Eq. 43): see *Error against run time* above.", "")
+        R.figures("penny_crack", ["error_vs_walltime.png"])
+    dmg = R.read("penny_crack_damage") if "penny_crack_damage" in R.dirs else None
+    s = dmg or s
     if s is None:
         return
+    if dmg is not None:
+        R.w(f"Damage growth (from `{R.folder('penny_crack_damage')}`):", "")
     ext = s.get("crack_extension_cells") or []
     paper = {round(p["t_s"], 3): p["cells"] for p in s.get("paper_crack_extension_cells", [])}
     if ext:
@@ -164,7 +176,8 @@ def penny(R):
         R.w(*table(ext, [("t [s]", lambda r: r["t_s"]), ("left", lambda r: r.get("left")), ("right", lambda r: r.get("right")),
                          ("paper", lambda r: paper.get(round(r["t_s"], 3)))]))
     R.w(f"Wall time {fmt(s.get('wall_time_s'))} s, {fmt(s.get('particles'))} particles.", "")
-    R.figures("penny_crack")
+    if dmg is not None:
+        R.figures("penny_crack_damage", ["crack_extension.png", "damage_law0_t0.40s.png"])
 
 
 def stability(R):
@@ -177,7 +190,7 @@ def stability(R):
                                     ("NaN seen", lambda r: r.get("nan_seen")), ("wall [s]", lambda r: r.get("wall_time_s")),
                                     ("passed", lambda r: r.get("passed"))]))
     R.w(f"All passed: {fmt(s.get('all_passed'))}.", "")
-    R.figures("stability")
+    R.figures("stability", ["energy_ratio.png"])
 
 
 def uniaxial(R):
@@ -193,7 +206,7 @@ def uniaxial(R):
             keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None][:8]
             R.w(f"**{k}**", "")
             R.w(*table(v, [(c, (lambda c: lambda r: r.get(c))(c)) for c in keys]))
-    R.figures("uniaxial_flaw")
+    R.figures("uniaxial_flaw", ["curves_mu.png", "curves_c.png", "damage_plastic_open.png", "damage_plastic_filled_mu0.6_c0MPa.png"])
 
 
 # ------------------------------------------------------------------------------------------ tunnel
