@@ -108,8 +108,7 @@ def log(msg):
 
 
 # ---------------------------------------------------------------------------------------------- MPM
-SPECIMEN = (0.05, 0.15)                     # width × height [m] (paper Sec. 3.3)
-FLAW = dict(center=(0.025, 0.075), length=0.025, width=0.002, angle=math.radians(30.0))
+SPECIMEN = (cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT)     # width × height [m] (paper Sec. 3.3)
 CAP_CELLS = 3                               # MPM end caps: no tensile damage within 3 cells of a platen
 DAMPING = 0.4                               # local (Cundall) damping on both sides: MPM solver.damping, YADE Newton
 
@@ -123,7 +122,11 @@ def platen_velocity(t, a):
 
 
 def uniaxial_flaw():
-    return ym.rotated_rectangle(FLAW["center"], FLAW["length"], FLAW["width"], FLAW["angle"])
+    """The 25 × 2 mm flaw at 30° at the specimen centre (cases.UNIAXIAL_FLAW), rising to the right: the
+    mirror image of cases.uniaxial_flaw_geometry() (same mechanics; the runs in doc/mpm_vs_bonded.md
+    used this one)."""
+    length, width, angle = cases.UNIAXIAL_FLAW
+    return ym.rotated_rectangle((SPECIMEN[0] / 2, SPECIMEN[1] / 2), length, width, angle)
 
 
 def mpm_uniaxial_saved(flaw, a):
