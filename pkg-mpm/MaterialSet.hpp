@@ -93,6 +93,30 @@ public:
 		return r;
 	}
 	const Entry& of(const Particles<D>& P, size_t p) const { return list[P.mat[p]]; }
+	// The stress particle p carries: the damaged stress for DP–GK (Eq. 40), else the state.
+	Sym<D> effectiveStress(const Particles<D>& P, size_t p) const
+	{
+		if (of(P, p).kind == MaterialKind::DruckerPragerGradyKipp) return DruckerPragerGradyKipp<D>::damaged(P.stress(p), P.damage[p]);
+		return P.stress(p);
+	}
+	// Current cohesion of a DP–GK particle (Eq. 34) [Pa]; NaN for other materials.
+	Real cohesion(const Particles<D>& P, size_t p) const
+	{
+		const auto& e = of(P, p);
+		return e.kind == MaterialKind::DruckerPragerGradyKipp ? e.dpgk.cohesionAt(P.epsP[p]) : NAN;
+	}
+	// Elastic energy stored by the effective stress, Σ V (s:s/(4G) + σm²/(2K)) with each particle's K, G [J].
+	Real elasticEnergy(const Particles<D>& P) const
+	{
+		Real e = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			const ElasticMat& m  = of(P, p).elastic;
+			Sym<D>            s  = effectiveStress(P, p);
+			Real              sm = s.toDeviator();
+			e += P.vol[p] * (s.contract() / (4 * m.shear()) + sm * sm / (2 * m.bulk()));
+		}
+		return e;
+	}
 	// Eq. 37 thresholds ε_D⁰ (with a flaw population: of the first flaw) for particles [from, n) whose
 	// material is DP–GK with damage on; allocates the activated-flaw counts when a material has flaws.
 	void initDamageThresholds(Particles<D>& P, size_t from) const

@@ -34,14 +34,25 @@ struct Particles {
 	void ensureTraction()
 	{
 		if (hasTraction()) return;
-		for (int a = 0; a < D; ++a) trac[a].assign(n, 0.0);
+		for (int a = 0; a < D; ++a) trac[a].reserve(x[0].capacity()), trac[a].assign(n, 0.0);
 	}
 	void ensureDamageState()
 	{
 		if (hasDamageState()) return;
-		epsP.assign(n, 0.0);
-		damage.assign(n, 0.0);
-		eps0.assign(n, 0.0);
+		for (auto* f : { &epsP, &damage, &eps0 }) f->reserve(x[0].capacity()), f->assign(n, 0.0);
+	}
+	// Room for `total` particles in every allocated array (no move while appending up to that count).
+	void reserve(size_t total)
+	{
+		forEachRealField([&](std::vector<Real>& f) { f.reserve(total); });
+		id.reserve(total), mat.reserve(total);
+	}
+	// True if n more particles fit into every allocated array without moving it.
+	bool fits(size_t more) const
+	{
+		bool ok = id.capacity() >= n + more && mat.capacity() >= n + more;
+		const_cast<Particles*>(this)->forEachRealField([&](std::vector<Real>& f) { ok = ok && f.capacity() >= n + more; });
+		return ok;
 	}
 
 	// Every allocated per-particle Real array, for permutation and append.
@@ -136,6 +147,23 @@ struct Particles {
 			if (!(epsP[p] >= 0 && std::isfinite(epsP[p]))) bad("plastic strain epsP", p, epsP[p], "[0, inf)");
 			if (thresholds(p) && !(eps0[p] > 0 && eps0[p] < 1)) bad("damage threshold eps0", p, eps0[p], "(0, 1)");
 		}
+	}
+
+	Real kineticEnergy() const // Σ ½ m v² [J]
+	{
+		Real e = 0;
+		for (size_t p = 0; p < n; ++p)
+			for (int a = 0; a < D; ++a) e += 0.5 * mass[p] * v[a][p] * v[a][p];
+		return e;
+	}
+	// Work of gravity g and the surface forces (× loadScale) on the particles over dt, Σ (m g + s f)·v dt [J].
+	template <class Vec>
+	Real externalWork(const Vec& g, Real loadScale, Real dt) const
+	{
+		Real w = 0;
+		for (size_t p = 0; p < n; ++p)
+			for (int a = 0; a < D; ++a) w += (mass[p] * g[a] + (hasTraction() ? loadScale * trac[a][p] : 0.0)) * v[a][p] * dt;
+		return w;
 	}
 
 	Sym<D> stress(size_t p) const

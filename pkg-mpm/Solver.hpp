@@ -41,6 +41,8 @@ public:
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
 
+	size_t          liveViews = 0; // arrays handed out without copy (NumPy views, binding layer): appending must not move them
+
 	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { materials.setCell(grid.spacing); }
 	Solver(const Solver&)            = delete; // xfer refers to the members
 	Solver& operator=(const Solver&) = delete;
@@ -50,6 +52,9 @@ public:
 	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n, long material = 0)
 	{
 		materials.checkIndex(material);
+		if (liveViews && !P.fits(n))
+			throw InputError("addParticles: " + std::to_string(liveViews) + " NumPy view(s) of the particle arrays are alive and adding " + std::to_string(n)
+			                 + " particles would move the arrays they point to; delete the views first (del v), or call reserve(total particles) before taking them");
 		const size_t old = P.n;
 		if (materials.size() && materials[size_t(material)].kind == MaterialKind::DruckerPragerGradyKipp)
 			materials[size_t(material)].dpgk.checkThresholds(vol, n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything is added
@@ -59,6 +64,16 @@ public:
 			materials.initDamageThresholds(P, old);
 		}
 		needSort = needCheck = true;
+	}
+	// Capacity for `total` particles: later addParticles up to that count keep the arrays (and live views) in place.
+	void reserve(size_t total) { P.reserve(total); }
+	// Simulated clock and energy account, e.g. for a resumed run: refused unless finite, time and steps ≥ 0.
+	void setClock(long nSteps, Real t, Real work)
+	{
+		if (nSteps < 0) throw InputError("steps = " + std::to_string(nSteps) + " is outside the allowed range [0, inf)");
+		requireRange(t, 0, INFINITY, false, true, "time", "[s]");
+		requireFinite(work, "externalWork [J]");
+		steps = nSteps, time = t, externalWork = work;
 	}
 	// A further material for particles added with addParticles(…, material = index); returns the index.
 	template <class Mat>
@@ -120,11 +135,15 @@ public:
 	void step()
 	{
 		prepare();
+		if (!autoDt && !(fixedDt > 0)) throw InputError("fixedDt = 0 s is not set: set fixedDt > 0 s or autoDt = True");
 		advance(autoDt ? stableDt() : fixedDt);
 	}
 	// One step of length dt (paper Fig. 2); dt above the stable step is refused.
 	void advance(Real dt)
 	{
+		if (!failure.empty())
+			throw SimulationError("cannot step: the last step failed after it had partly updated the particles (" + failure
+			                      + "); restore a checkpoint (yade_mpm.checkpoint) or rebuild the scene");
 		prepare();
 		requireRange(dt, 0, INFINITY, true, true, "dt", "[s]");
 		const Real lim = stableDt();
@@ -169,13 +188,14 @@ public:
 				}
 				stamp(t[4]);
 			}
-			throwIf(errP2G, "P2G"), throwIf(errContact, "contact"), throwIf(errG2P, "G2P");
+			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
+			throwIf(errG2P, "G2P", true);
 			ErrorRecord err;
 			const Real  rmin = updateStress(xfer, mat, dt, err);
-			throwIf(err, "stress update");
+			throwIf(err, "stress update", true);
 			bool       drift = false;
 			const Real vm    = moveParticles(xfer, dt, err, drift);
-			throwIf(err, "position update");
+			throwIf(err, "position update", true);
 			vmax = vm, rhoMin = rmin;
 			if (drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
 			t[5] = omp_get_wtime();
@@ -189,39 +209,16 @@ public:
 	}
 
 	// ---------------------------------------------------------------- diagnostics
-	Real kineticEnergy() const
-	{
-		Real e = 0;
-		for (size_t p = 0; p < P.n; ++p)
-			for (int a = 0; a < D; ++a) e += 0.5 * P.mass[p] * P.v[a][p] * P.v[a][p];
-		return e;
-	}
-	// Elastic energy stored by the (effective) stress, Σ V (s:s/(4G) + σm²/(2K)) with each particle's K, G [J].
-	Real elasticEnergy() const
-	{
-		Real e = 0;
-		for (size_t p = 0; p < P.n; ++p) {
-			const ElasticMat& m  = materials.of(P, p).elastic;
-			Sym<D>            s  = effectiveStress(p);
-			Real              sm = s.toDeviator();
-			e += P.vol[p] * (s.contract() / (4 * m.shear()) + sm * sm / (2 * m.bulk()));
-		}
-		return e;
-	}
-	// The stress the particle carries: the damaged stress for DP–GK (Eq. 40), else the state.
-	Sym<D> effectiveStress(size_t p) const
-	{
-		if (materials.of(P, p).kind == MaterialKind::DruckerPragerGradyKipp) return DruckerPragerGradyKipp<D>::damaged(P.stress(p), P.damage[p]);
-		return P.stress(p);
-	}
-	// Current cohesion of a DP–GK particle (Eq. 34) [Pa]; NaN for other materials.
-	Real cohesion(size_t p) const
-	{
-		const auto& e = materials.of(P, p);
-		return e.kind == MaterialKind::DruckerPragerGradyKipp ? e.dpgk.cohesionAt(P.epsP[p]) : NAN;
-	}
+	Real   kineticEnergy() const { return P.kineticEnergy(); }
+	Real   elasticEnergy() const { return materials.elasticEnergy(P); } // stored by the effective stress [J]
+	Sym<D> effectiveStress(size_t p) const { return materials.effectiveStress(P, p); } // damaged for DP–GK (Eq. 40)
+	Real   cohesion(size_t p) const { return materials.cohesion(P, p); }               // Eq. 34; NaN if not DP–GK
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
-	Real maxSpeed() const { return vmax; }
+	Real maxSpeed() // max ‖v‖ [m/s], refreshed after requestSort()
+	{
+		if (needCheck && P.n && materials.size()) prepare();
+		return vmax;
+	}
 	const BlockSchedule<D>& schedule() const { return sched; }
 	// Python calls this after writing particle views: re-sort and re-validate before the next step.
 	void requestSort() { needSort = needCheck = true; }
@@ -236,11 +233,18 @@ public:
 	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, rhoMin, massFloor, needSort, needCheck }; }
 	void setResumeState(const ResumeState& r, const std::vector<uint32_t>& blockStart)
 	{
+		const long s0 = steps;
+		const Real t0 = time, w0 = externalWork;
+		setClock(r.steps, r.time, r.externalWork); // checked before anything else changes
 		const bool neverSorted = blockStart.empty() && r.needSort; // saved before the first step
-		if (!neverSorted && !sched.restore(grid, blockStart, P.n)) throw InputError("checkpoint: the block schedule does not fit this grid and particle count");
-		steps = r.steps, time = r.time, lastDt = r.lastDt, externalWork = r.externalWork;
+		if (!neverSorted && !sched.restore(grid, blockStart, P.n)) {
+			setClock(s0, t0, w0);
+			throw InputError("checkpoint: the block schedule does not fit this grid and particle count");
+		}
+		lastDt = r.lastDt;
 		vmax = r.vmax, rhoMin = r.rhoMin, massFloor = r.massFloor;
 		needSort = r.needSort, needCheck = r.needCheck;
+		failure.clear();
 	}
 
 private:
@@ -251,17 +255,22 @@ private:
 	bool             needCheck = true;   // particle data changed from outside: validate and refresh ρ_min, mass floor
 	Real             vmax = 0, rhoMin = INFINITY, massFloor = 0;
 	ErrorRecord      errP2G, errContact, errG2P; // shared by the threads of the transfer region
+	std::string      failure;                    // message of a step that failed with particles partly updated
 
 	static void stamp(double& t)
 	{
 #pragma omp master
 		t = omp_get_wtime();
 	}
-	void throwIf(const ErrorRecord& e, const char* phaseName) const
+	// After a failure in a phase that had already changed particles (partly), the state is not one of
+	// the scheme's states: further steps are refused until a checkpoint is restored (setResumeState).
+	void throwIf(const ErrorRecord& e, const char* phaseName, bool particlesChanged)
 	{
 		if (e.none()) return;
-		throw SimulationError("MPM stopped at step " + std::to_string(steps) + " (t = " + fmtNum(time) + " s) in " + phaseName + ": particle id "
-		                      + std::to_string(P.id[e.particle]) + " " + e.what);
+		const std::string what = "MPM stopped at step " + std::to_string(steps) + " (t = " + fmtNum(time) + " s) in " + phaseName + ": particle id "
+		                         + std::to_string(P.id[e.particle]) + " " + e.what;
+		if (particlesChanged) failure = what;
+		throw SimulationError(what);
 	}
 
 	// Validation that must precede any work; cheap when nothing changed.
@@ -278,20 +287,13 @@ private:
 				return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
 			});
 			rhoMin       = materials.single() ? c.rhoMin : materials.minDtDensity(P);
-			vmax         = std::max(vmax, c.vmax);
+			vmax         = c.vmax; // also lowered when velocities were lowered through the views
 			massFloor    = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)
 			needCheck    = false;
 		}
 	}
 
-	void accumulateExternalWork(Real dt)
-	{
-		const Real s = loadScale(time + dt);
-		Real       w = 0;
-		for (size_t p = 0; p < P.n; ++p)
-			for (int a = 0; a < D; ++a) w += (P.mass[p] * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0)) * P.v[a][p] * dt;
-		externalWork += w;
-	}
+	void accumulateExternalWork(Real dt) { externalWork += P.externalWork(gravity, loadScale(time + dt), dt); }
 };
 
 } // namespace mpm

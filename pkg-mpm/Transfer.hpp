@@ -29,15 +29,21 @@ public:
 	{
 		for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) f(size_t(p));
 	}
-	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums).
-	template <class F>
-	void scatterPass(F&& f) const
+	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums);
+	// fb(b) handles block b. scatterPass(f) calls f(p) for every particle of every block.
+	template <class FB>
+	void scatterBlocks(FB&& fb) const
 	{
 		for (int c = 0; c < Dim<D>::nColours; ++c) {
 			const auto& blocks = sched.colour[c];
 #pragma omp for schedule(dynamic, 1)
-			for (size_t k = 0; k < blocks.size(); ++k) forBlock(blocks[k], f);
+			for (size_t k = 0; k < blocks.size(); ++k) fb(blocks[k]);
 		}
+	}
+	template <class F>
+	void scatterPass(F&& f) const
+	{
+		scatterBlocks([&](uint32_t b) { forBlock(b, f); });
 	}
 	void kernelOf(size_t p, Kernel<D>& k) const
 	{
@@ -60,48 +66,62 @@ public:
 		for (size_t i = 0; i < nodes.size(); ++i) lanes(nodes[i]) = NodeLanes {}; // padding lanes too
 		const Real s    = loadScale;
 		const Real Dinv = 3.0 / (grid.spacing * grid.spacing); // interior M⁻¹ gradient factor
-		scatterPass([&](size_t p) {
-			Kernel<D> k;
-			kernelOf(p, k);
-			if (!k.inside) return err.record(p, "has a position outside the grid or not finite: " + positionText(p));
-			const Real   m = P.mass[p], V = P.vol[p];
-			const Sym<D> sg = mat.forceStress(P, p);
-			Real         mv[D], mC[D][D], fe[D];
-			for (int a = 0; a < D; ++a) {
-				mv[a] = m * P.v[a][p];
-				for (int b = 0; b < D; ++b) mC[a][b] = m * P.C[a * D + b][p];
-				fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
-			}
-			if (!k.general) {
-				Real sgm[D][D];
-				sym2full(sg, sgm);
-				const NodeLanes P0 = nodeLanes<D>(m, m, mv, fe); // lanes: m, mw, momentum…, force…
-				NodeLanes       A[D];
-				for (int b = 0; b < D; ++b) {
-					Real ca[D], fa[D];
-					for (int a = 0; a < D; ++a) {
-						ca[a] = mC[a][b];
-						fa[a] = -V * Dinv * sgm[a][b]; // Eq. 21, f_int = −Σ V σ ∇ψ
-					}
-					A[b] = nodeLanes<D>(0, 0, ca, fa);
-				}
-				scatterAffine(grid, k, P0, A); // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
-				return;
-			}
-			Stencil<D> st;
-			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
-			forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
-				const Real psi = st.psi[n];
-				nd.m += psi * m;      // Eq. 20
-				nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
-				Real sg_g[D];
-				stressTimesVector(sg, st.grad[n], sg_g);
+		const Real invH = 1.0 / grid.spacing;
+		scatterBlocks([&](uint32_t blk) {
+			Real cellLo[D], cellHi[D]; // cells a particle of this block may reach: beyond, the colouring breaks
+			sched.reach(blk, cellLo, cellHi);
+			forBlock(blk, [&](size_t p) {
+				Kernel<D> k;
+				kernelOf(p, k);
+				if (!k.inside) return err.record(p, "has a position outside the grid or not finite: " + positionText(p));
+				const Real m = P.mass[p], V = P.vol[p];
+				// State written through the views without requestSort() is refused before it is used.
 				for (int a = 0; a < D; ++a) {
-					Real mom = mv[a];
-					for (int b = 0; b < D; ++b) mom += mC[a][b] * dx[b];
-					nd.a[a] += psi * mom;                  // momentum of the affine velocity field (Eq. 16)
-					nd.b[a] += -V * sg_g[a] + psi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+					const Real f = (P.x[a][p] - grid.origin[a]) * invH;
+					if (!(f >= cellLo[a] && f < cellHi[a]))
+						return err.record(p, "at " + positionText(p) + " lies beyond the cells its block may reach before a re-sort "
+						                     "(moved through a view?): call solver.requestSort() after writing positions");
 				}
+				if (!(m > 0 && m < INFINITY)) return err.record(p, "has mass m = " + fmtNum(m) + " kg, must be finite and > 0 (written through a view?)");
+				if (!(V > 0 && V < INFINITY)) return err.record(p, "has volume V = " + fmtNum(V) + " m³, must be finite and > 0 (written through a view?)");
+				const Sym<D> sg = mat.forceStress(P, p);
+				Real         mv[D], mC[D][D], fe[D];
+				for (int a = 0; a < D; ++a) {
+					mv[a] = m * P.v[a][p];
+					for (int b = 0; b < D; ++b) mC[a][b] = m * P.C[a * D + b][p];
+					fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
+				}
+				if (!k.general) {
+					Real sgm[D][D];
+					sym2full(sg, sgm);
+					const NodeLanes P0 = nodeLanes<D>(m, m, mv, fe); // lanes: m, mw, momentum…, force…
+					NodeLanes       A[D];
+					for (int b = 0; b < D; ++b) {
+						Real ca[D], fa[D];
+						for (int a = 0; a < D; ++a) {
+							ca[a] = mC[a][b];
+							fa[a] = -V * Dinv * sgm[a][b]; // Eq. 21, f_int = −Σ V σ ∇ψ
+						}
+						A[b] = nodeLanes<D>(0, 0, ca, fa);
+					}
+					scatterAffine(grid, k, P0, A); // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
+					return;
+				}
+				Stencil<D> st;
+				if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+				forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
+					const Real psi = st.psi[n];
+					nd.m += psi * m;      // Eq. 20
+					nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
+					Real sg_g[D];
+					stressTimesVector(sg, st.grad[n], sg_g);
+					for (int a = 0; a < D; ++a) {
+						Real mom = mv[a];
+						for (int b = 0; b < D; ++b) mom += mC[a][b] * dx[b];
+						nd.a[a] += psi * mom;                  // momentum of the affine velocity field (Eq. 16)
+						nd.b[a] += -V * sg_g[a] + psi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+					}
+				});
 			});
 		});
 	}

@@ -196,13 +196,13 @@ struct SolverWrap {
 		if (name == "damage") f = &P.damage;
 		if (name == "eps0") f = &P.eps0;
 		if (name == "material") // checked at the next step (requestSort); ε_D⁰ (eps0) is not recomputed
-			return np::from_data(P.mat.data(), np::dtype::get_builtin<uint8_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(uint8_t)), self);
+			return np::from_data(P.mat.data(), np::dtype::get_builtin<uint8_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(uint8_t)), viewOwner(self));
 		if (name == "nFlaw") f = &P.nFlaw;
 		if (name == "id")
-			return np::from_data(P.id.data(), np::dtype::get_builtin<int64_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(int64_t)), self);
+			return np::from_data(P.id.data(), np::dtype::get_builtin<int64_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(int64_t)), viewOwner(self));
 		if (!f) throw InputError("unknown particle field '" + name + "'");
 		if (f->size() != P.n) throw InputError("particle field '" + name + "' is not allocated in this scene");
-		return np::from_data(f->data(), np::dtype::get_builtin<double>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(double)), self);
+		return np::from_data(f->data(), np::dtype::get_builtin<double>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(double)), viewOwner(self));
 	}
 
 	// Per-particle stress actually carried (damaged for DP–GK), shape (N, nSym), copied.
@@ -524,9 +524,23 @@ struct SolverWrap {
 
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
+	// steps: checked setter (setClock); time and externalWork are declared in SolverSettings.hpp.
+	static void setSteps(S& s, bp::object n) { s.setClock(long(argInt(n, who("steps"), 0, 9.2e18)), s.time, s.externalWork); }
+	static void reserve(S& s, bp::object n) { s.reserve(size_t(argInt(n, who("reserve: particles"), 0, 4e9))); }
+
+	// Owner of NumPy views: counts the live views of a solver so that addParticles can refuse to move
+	// arrays under them (Solver::liveViews).
+	struct ViewOwner {
+		std::shared_ptr<S> s;
+		explicit ViewOwner(std::shared_ptr<S> solver) : s(std::move(solver)) { ++s->liveViews; }
+		~ViewOwner() { --s->liveViews; }
+	};
+	static bp::object viewOwner(bp::object self) { return bp::object(std::make_shared<ViewOwner>(bp::extract<std::shared_ptr<S>>(self)())); }
+
 	static void expose(const char* name)
 	{
 		ParamBinding<S>::declare(name);
+		bp::class_<ViewOwner, std::shared_ptr<ViewOwner>, boost::noncopyable>((std::string("_ViewOwner") + name).c_str(), bp::no_init);
 		bp::class_<S, std::shared_ptr<S>, boost::noncopyable> cls(name, "Explicit WLS-MPM solver (MUSL) on a fixed regular grid.", bp::no_init);
 		ParamBinding<S>::exposeProperties(cls); // settings and writable state, checked (SolverSettings.hpp)
 		cls.def("settings", &settings, "The settings (SolverSettings.hpp) as a dict {name: value}.")
@@ -592,7 +606,9 @@ struct SolverWrap {
 		        .add_property("origin", &getOrigin)
 		        .add_property("cells", &getCells)
 		        .add_property("storedNodes", &getStored)
-		        .def_readonly("steps", &S::steps)
+		        .add_property("steps", bp::make_getter(&S::steps), &setSteps, "steps taken, range [0, inf)")
+		        .def("reserve", &reserve, bp::arg("particles"),
+		             "Room for this many particles: later addParticles up to that count keep the arrays (and live views) in place.")
 		        .def_readonly("lastDt", &S::lastDt)
 		        .add_property("maxSpeed", &S::maxSpeed);
 	}
