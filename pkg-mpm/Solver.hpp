@@ -37,7 +37,6 @@ public:
 	Grid<D>         grid;
 	Particles<D>    P;
 	ContactPhase<D> contact;
-	long            steps = 0;
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
 

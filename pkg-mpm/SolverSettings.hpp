@@ -21,4 +21,5 @@
 // State a script may set (resume, restart): checked like the settings, not part of settings().
 #define MPM_SOLVER_STATE(X)                                                                                          \
 	X(Real, time, 0, "s", 0, INFINITY, CO, "t", "simulated time (ramped tractions are evaluated at it)", "", "")   \
+	X(long, steps, 0, "steps", 0, 9.2e18, CC, "", "steps taken (the sort period counts from it)", "", "")          \
 	X(Real, externalWork, 0, "J", -INFINITY, INFINITY, OO, "W_ext", "work of gravity and surface forces (trackEnergy)", "", "")

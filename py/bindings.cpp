@@ -524,8 +524,6 @@ struct SolverWrap {
 
 	static int materialKind(S& s) { return int(s.materialKind()); }
 
-	// steps: checked setter (setClock); time and externalWork are declared in SolverSettings.hpp.
-	static void setSteps(S& s, bp::object n) { s.setClock(long(argInt(n, who("steps"), 0, 9.2e18)), s.time, s.externalWork); }
 	static void reserve(S& s, bp::object n) { s.reserve(size_t(argInt(n, who("reserve: particles"), 0, 4e9))); }
 
 	// Owner of NumPy views: counts the live views of a solver so that addParticles can refuse to move
@@ -606,7 +604,6 @@ struct SolverWrap {
 		        .add_property("origin", &getOrigin)
 		        .add_property("cells", &getCells)
 		        .add_property("storedNodes", &getStored)
-		        .add_property("steps", bp::make_getter(&S::steps), &setSteps, "steps taken, range [0, inf)")
 		        .def("reserve", &reserve, bp::arg("particles"),
 		             "Room for this many particles: later addParticles up to that count keep the arrays (and live views) in place.")
 		        .def_readonly("lastDt", &S::lastDt)
