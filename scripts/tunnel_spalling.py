@@ -307,9 +307,14 @@ class CaseRun:
                 near_toe = self.rock & (np.hypot(*(self.x0 - fl["toe"]).T) < 4e-3)
                 link = analysis.clusters_touching(failed, self.lattice, near_toe & failed)
                 reach = link & analysis.opening_surface(self.lattice, opening)
+                # the same for the localised plastic strain (the shear band threshold) grown from the toe
+                plastic = self.rock & (f["epsP"] >= thr)
+                plink = analysis.clusters_touching(plastic, self.lattice, near_toe & plastic)
+                preach = plink & analysis.opening_surface(self.lattice, opening)
                 toe = dict(toe_damaged=int(np.count_nonzero(near_toe & (f["damage"] >= 1))),
                            toe_softened=int(np.count_nonzero(near_toe & shear)),
-                           toe_link_to_opening=self._where(self.x0[reach]) if reach.any() else None)
+                           toe_link_to_opening=self._where(self.x0[reach]) if reach.any() else None,
+                           toe_plastic_link_to_opening=self._where(self.x0[preach]) if preach.any() else None)
             res["snapshots"][key] = dict(
                 time_ms=float(f["time"] * 1e3), displacement_mm=float(f["displacement"] * 1e3),
                 symmetry_damage=analysis.mirror_symmetry(np.where(self.rock, f["damage"], 0), self.lattice, cx),
@@ -395,7 +400,8 @@ class CaseRun:
                       for b in info["bands"][:5]] or ["   none"]
             if "toe_damaged" in info:
                 lines += [f"flaw toe (4 mm): {info['toe_damaged']} with D = 1, {info['toe_softened']} softened",
-                          f"   failed zone from the toe reaches: {info['toe_link_to_opening'] or 'nowhere'}"]
+                          f"   failed zone from the toe reaches: {info['toe_link_to_opening'] or 'nowhere'}",
+                          f"   plastic band from the toe reaches: {info.get('toe_plastic_link_to_opening') or 'nowhere'}"]
             axs[5].text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, family="monospace", transform=axs[5].transAxes)
             fig.tight_layout()
             fig.savefig(os.path.join(self.dir, f"fields_{key}.png"), dpi=90)
@@ -418,7 +424,8 @@ class CaseRun:
                      + (f"yes, at {i['spalling_at']}, {i['spalled_area_mm2']:.0f} mm² ({i['spalled_mass_kg_per_m']:.3f} kg per m of tunnel, "
                         f"{i['spalled_fragments']} particles in detached fragments)" if i["spalling_at"] else "no")
                      + (f"; flaw toe: {i['toe_damaged']} particles D = 1, {i['toe_softened']} softened within 4 mm, failed zone from "
-                        f"the toe reaches the opening at: {i['toe_link_to_opening'] or 'nowhere'}" if "toe_damaged" in i else ""))
+                        f"the toe reaches the opening at: {i['toe_link_to_opening'] or 'nowhere'}, plastic band (ε̄p ≥ {i['band_threshold']:.1e}) "
+                        f"from the toe reaches it at: {i.get('toe_plastic_link_to_opening') or 'nowhere'}" if "toe_damaged" in i else ""))
         return "\n".join(L)
 
 
