@@ -9,6 +9,12 @@ of two cell layers; the crack faces carry the pressure P as a particle traction.
   damage       DP–GK rock, P = 75 MPa ramped linearly: crack extension Δa(t) [cells] vs the paper's
                7, 22, 72 cells at t = 0.1, 0.2, 0.4 s; damage fields; plastic particle count.
 
+Outer boundary (--edges, --edge-set): slip on the top and bottom faces by default — a supported block,
+whose crack grows stably; "free" is the unsupported block, whose crack runs to the edge once K(a) passes
+its minimum (doc/penny_crack.md). Damage options map onto DpGkMat parameters: --threshold-volume
+(thresholdVolume, V of Eq. 37), --damage-strain (damageStrain, Eq. 36), --threshold-cell (thresholdCell,
+regularised threshold), --flaws/--flaw-seed (flawCount/flawSeed, Benz–Asphaug population).
+
 The paper ramps P over 0.5 s (≈ 160 k steps at l = 0.02 m). The load is quasi-static (the P-wave
 crosses the 5 m block in 1.5 ms), so by default the ramp is compressed to --ramp-time seconds and
 results are reported on the paper's time axis t_paper = t · 0.5 s / ramp-time (= the same pressure

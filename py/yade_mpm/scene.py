@@ -165,7 +165,8 @@ def _order(solver):
 def get(solver, name, order=None):
     """Copy of a particle field in particle-id order. Names: pos, vel, stress (the stress carried,
     damaged for DP–GK; components xx, yy, zz, xy[, xz, yz], tension positive, [Pa]), state_stress,
-    max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass, volume, id."""
+    max_principal_stress [Pa], damage, plastic_strain (ε̄p of the rock: a fully damaged particle keeps no
+    tension, so an opening crack does not yield), cohesion [Pa], mass, volume, id."""
     d = dim_of(solver)
     o = _order(solver) if order is None else order   # pass order=id_order(solver) when reading many fields
     if name == "pos":
