@@ -1,12 +1,13 @@
 """yade-mpm side by side with YADE's bonded-particle rock model JCFpm (Scholtès & Donzé 2012).
 
 1. Uniaxial compression of the paper's Sec. 3.3 specimen (50 × 150 mm, Miao et al. 2018 sandstone),
-   intact and with the 25 × 2 mm open flaw at 30°, between two frictionless YADE walls; the top one
-   closes at --platen-speed, reached by a linear ramp over 1 ms; local damping 0.4 on both sides:
-   - MPM: 2D plane strain WLS-MPM with DP–GK damage, the walls through PTS contact (RigidBodies, μ = 0),
-     grid spacing --mpm-spacing, ppc = 2; end caps: no tensile damage within 3 cells of a platen
-     (--capped-ends; without them the layer under the penalty contact cracks first).
-   - JCFpm: a layer of bonded spheres, centres at z = 0, motion restricted to the plane
+   intact and with the 25 × 2 mm open flaw at 30° (cases.uniaxial_flaw_geometry, the paper's orientation),
+   loaded from the top at --platen-speed, reached by a linear ramp over 1 ms; local damping 0.4 on both sides:
+   - MPM: the scene of cases.uniaxial_flaw ("intact"/"open"): 2D plane strain WLS-MPM with DP–GK damage,
+     free-slip base, frictionless rigid YADE platen in PTS contact (RigidBodies), grid nodes inside the flaw
+     excluded, grid spacing --mpm-spacing, ppc = 2; end caps: no tensile damage within 3 cells of the base
+     and the platen (--capped-ends; without them the layer under the penalty contact cracks first).
+   - JCFpm: between two frictionless YADE walls, the top one closing as the MPM platen; a layer of bonded spheres, centres at z = 0, motion restricted to the plane
      (yade_mpm.bonded; plane strain: ε_zz = 0 exactly), mean radius --dem-radius, thickness mapping
      t = 2 r̄ (stress = platen force / (W t)).
    "E" on both sides is the apparent plane-strain modulus Δσ_yy/Δε_yy of the test (slope of the first
@@ -111,22 +112,7 @@ def log(msg):
 SPECIMEN = (cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT)     # width × height [m] (paper Sec. 3.3)
 CAP_CELLS = 3                               # MPM end caps: no tensile damage within 3 cells of a platen
 DAMPING = 0.4                               # local (Cundall) damping on both sides: MPM solver.damping, YADE Newton
-
-
 RAMP_TIME = 1e-3                            # platen speed ramped linearly from 0 over this time [s] (both methods)
-
-
-def platen_velocity(t, a):
-    """Platen closing speed at time t [m/s]: linear ramp over RAMP_TIME (no start-up shock), then constant."""
-    return a.platen_speed * min(1.0, t / RAMP_TIME)
-
-
-def uniaxial_flaw():
-    """The 25 × 2 mm flaw at 30° at the specimen centre (cases.UNIAXIAL_FLAW), rising to the right: the
-    mirror image of cases.uniaxial_flaw_geometry() (same mechanics; the runs in doc/mpm_vs_bonded.md
-    used this one)."""
-    length, width, angle = cases.UNIAXIAL_FLAW
-    return ym.rotated_rectangle((SPECIMEN[0] / 2, SPECIMEN[1] / 2), length, width, angle)
 
 
 def mpm_uniaxial_saved(flaw, a):
@@ -143,37 +129,23 @@ def mpm_uniaxial_saved(flaw, a):
 
 
 def mpm_uniaxial(flaw, a):
-    """MPM uniaxial run: the specimen between two frictionless YADE walls (PTS contact, RigidBodies), the
-    top one moving down at platen_speed; DP–GK sandstone, ppc = 2, local damping DAMPING. Returns
-    dict(strain, stress [Pa] compression +, particles, wall_time_s, pos, damage)."""
-    from yade import O, utils
-    from yade.wrapper import ForceResetter, NewtonIntegrator
-    O.reset()
-    W, H = SPECIMEN
+    """MPM uniaxial run on the scene of ``cases.uniaxial_flaw`` ("intact" or "open": free-slip base, rigid
+    frictionless YADE platen in PTS contact, the top moving down at platen_speed after a RAMP_TIME ramp),
+    DP–GK sandstone, ppc = 2, local damping DAMPING, end caps of CAP_CELLS cells (--capped-ends), grid room
+    of 8 cells beside the specimen. Returns dict(strain, stress [Pa] compression +, particles, wall_time_s,
+    pos, damage)."""
     l = a.mpm_spacing
-    s = ym.make_solver((0.0, 0.0), (W, H), l, margin=8)        # room for fragments pushed out sideways
-    ym.add_region(s, rocks.miao2018_sandstone(), (0.0, 0.0), (W, H), ppc=2, holes=[uniaxial_flaw()] if flaw else [])
+    s, sc = cases.uniaxial_flaw("open" if flaw else "intact", l, platen_speed=a.platen_speed, label="mpmUniax",
+                                ramp_time=RAMP_TIME, end_cap_cells=CAP_CELLS if a.capped_ends else 0, side_room=8 * l)
     s.damping = DAMPING
-    if a.capped_ends:
-        # end caps: the particles within CAP_CELLS cells of each platen get a Grady–Kipp activation strain
-        # that tension never reaches (ε_D⁰ = 0.99, Eq. 37), so the layer under the penalty contact does not crack
-        y, e0 = s.view("x1"), s.view("eps0")
-        e0[(y < CAP_CELLS * l) | (y > H - CAP_CELLS * l)] = 0.99
-    bot = O.bodies.append(utils.wall(0.0, axis=1, sense=1))
-    top = O.bodies.append(utils.wall(H, axis=1, sense=-1))
-    rb = ym.RigidBodies(s)
-    rb.add([bot, top], mu=0.0)
-    O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmUniax", bodies=rb).runner(), NewtonIntegrator(damping=0.0)]
-    O.dt = 1.0
     label = "mpm " + ("open flaw" if flaw else "intact")
     prog = ym.Progress(a.max_strain, label, 20.0)
     strain, stress, peak = [0.0], [0.0], 0.0
     t0, c0 = time.time(), time.process_time()
     while True:
-        O.bodies[top].state.vel = (0.0, -platen_velocity(O.time, a), 0.0)
-        O.run(100, True)
-        strain.append((H - (O.bodies[top].state.pos[1] - O.bodies[bot].state.pos[1])) / H)
-        stress.append(0.5 * (rb.force(top)[1] - rb.force(bot)[1]) / W)
+        sc["advance"](100)
+        strain.append(sc["axial_strain"]())
+        stress.append(sc["axial_stress"]())
         peak = max(peak, stress[-1])
         prog.update(s.steps, strain[-1])
         if strain[-1] >= a.max_strain or (len(stress) > 3 and max(stress[-3:]) < 0.7 * peak):   # 3 records past a 30 % drop
@@ -304,7 +276,7 @@ def uniaxial_part(a, summary):
         w.writeheader()
         w.writerows(rows)
     results["intact"] = dict(mpm=mpm_int, jcfpm=dem_int)
-    holes = [uniaxial_flaw()]
+    holes = [cases.uniaxial_flaw_geometry()["polygon"]]
     mpm_fl = mpm_uniaxial_saved(True, a)
     mpm_fl["youngs_modulus"] = bonded.apparent_modulus(mpm_fl["strain"], mpm_fl["stress"])
     mpm_fl["peak_stress"] = float(np.max(mpm_fl["stress"]))

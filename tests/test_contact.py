@@ -335,6 +335,38 @@ def test_uniaxial_builder_places_platen_and_filler():
         cases.uniaxial_flaw("cracked", 0.002)
 
 
+def test_uniaxial_builder_ramp_and_end_caps():
+    """cases.uniaxial_flaw options of scripts/compare_bonded.py: the platen at rest until advance(), then
+    moving each chunk at speed·min(1, t/ramp_time) of the chunk start (displacement = Σ v_k Δt_k, an
+    independent sum over the clock), ε_D⁰ = 0.99 exactly in the capped rows near base and platen and the
+    rock's value elsewhere; bad options refused before any work."""
+    from yade import O
+    from yade_mpm import cases
+    l, speed, ramp, caps = 0.005, 1.0, 2e-5, 2
+    e0_free = ym.get(cases.uniaxial_flaw("intact", l, side_room=4 * l)[0], "eps0")       # no caps: the rock's thresholds
+    s, sc = cases.uniaxial_flaw("intact", l, platen_speed=speed, ramp_time=ramp, end_cap_cells=caps, side_room=4 * l)
+    p = O.bodies[sc["platen"]]
+    assert p.state.vel[1] == 0.0
+    y0, H = p.state.pos[1], sc["height"]
+    x = ym.get(s, "pos")
+    e0 = ym.get(s, "eps0")
+    cap = (x[:, 1] < caps * l) | (x[:, 1] > H - caps * l)
+    assert cap.sum() == 2 * 2 * caps * (sc["width"] / (l / 2)) and np.all(e0[cap] == 0.99)
+    assert np.all(e0[~cap] == e0_free[~cap]) and np.all(e0_free < 0.99)
+    expect = 0.0
+    for _ in range(4):
+        t0 = O.time
+        sc["advance"](3)
+        expect += speed * min(1.0, t0 / ramp) * (O.time - t0)
+    assert O.time > ramp / 4
+    assert y0 - p.state.pos[1] == pytest.approx(expect, rel=1e-9)
+    assert sc["axial_strain"]() == pytest.approx(expect / H, rel=1e-9)
+    for kw, name in ((dict(ramp_time=-1e-3), "ramp_time"), (dict(end_cap_cells=1.5), "end_cap_cells"),
+                     (dict(end_cap_cells=H / l), "end_cap_cells"), (dict(side_room=0.0), "side_room")):
+        with pytest.raises(ValueError, match=name):
+            cases.uniaxial_flaw("intact", l, **kw)
+
+
 def test_thrown_free_box_conserves_total_momentum_3d():
     """The adapter's 3D path: a spinning free YADE box thrown at an elastic block (no gravity, no
     boundaries); total momentum of particles + box conserved every step, and the box bounces."""

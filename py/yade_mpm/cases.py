@@ -344,7 +344,8 @@ def exclude_nodes_inside(solver, polygon):
 
 
 def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
-                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY"):
+                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY",
+                  ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM):
     """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
     ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
@@ -354,12 +355,19 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
               "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
                         contact with μ_con = mu_con [-] and c_con = c_con [Pa].
     filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/contact.md).
+    ramp_time [s] ≥ 0: the platen speed rises linearly from 0 over this time when the run is driven by
+    scene["advance"](n) (speed updated before each call: a staircase with n-step treads); 0 (default) starts at
+    full speed. end_cap_cells ≥ 0: the particles within this many cells of the base and of the platen get a
+    Grady–Kipp activation strain ε_D⁰ = 0.99 (Eq. 37) that tension never reaches — "end caps", so the layer
+    under the penalty contact does not crack first (doc/mpm_vs_bonded.md); 0 (default) = none.
+    side_room [m] > 0: grid beyond each free side face (default UNIAXIAL_SIDE_ROOM).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
     rigid (RigidBodies), engine (MpmEngine), flaw (dict or None), width, height [m],
     axial_stress() -> platen reaction / width [Pa, compression positive],
-    axial_strain() -> platen displacement / height [-])."""
+    axial_strain() -> platen displacement / height [-],
+    advance(n) -> sets the (ramped) platen speed for the time O.time, then runs n steps)."""
     if variant not in UNIAXIAL_VARIANTS:
         raise ValueError(f"variant = {variant!r} must be one of {UNIAXIAL_VARIANTS}")
     W, H = UNIAXIAL_WIDTH, UNIAXIAL_HEIGHT
@@ -369,13 +377,23 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
                          "flaw must cut at least one full particle row")
     if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
         raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    if not (isinstance(ramp_time, (int, float)) and math.isfinite(ramp_time) and ramp_time >= 0):
+        raise ValueError(f"ramp_time = {ramp_time!r} s must be a finite number ≥ 0")
+    if not (isinstance(end_cap_cells, int) and 0 <= end_cap_cells < H / (2 * spacing)):
+        raise ValueError(f"end_cap_cells = {end_cap_cells!r} must be an integer in [0, height/(2·spacing)) = [0, {H / (2 * spacing):g})")
+    if not (isinstance(side_room, (int, float)) and math.isfinite(side_room) and side_room > 0):
+        raise ValueError(f"side_room = {side_room!r} m must be a finite number > 0")
     from yade import O
     from .bodies import RigidBodies
     rock = material or rocks.miao2018_sandstone()
-    side = UNIAXIAL_SIDE_ROOM                      # grid room beside the free faces for spalled fragments
+    side = side_room                               # grid room beside the free faces for spalled fragments
     s = make_solver((-side, 0), (W + side, H), spacing, margin=2)
     add_region(s, rock, (0, 0), (W, H), ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
     s.addBoundaryPlane(1, -1, 0.0, "slip")
+    if end_cap_cells > 0:                          # end caps: ε_D⁰ = 0.99 (Eq. 37) near the base and the platen
+        y, e0 = s.view("x1"), s.view("eps0")
+        e0[(y < end_cap_cells * spacing) | (y > H - end_cap_cells * spacing)] = 0.99
+        del y, e0
     if variant == "open":
         exclude_nodes_inside(s, flaw["polygon"])
     O.reset()
@@ -392,5 +410,12 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
 
     def axial_strain():
         return (y0 - O.bodies[platen].state.pos[1]) / H
+
+    def advance(n):
+        v = platen_speed * (min(1.0, O.time / ramp_time) if ramp_time > 0 else 1.0)
+        O.bodies[platen].state.vel = (0, -v, 0)
+        O.run(n, True)
+    if ramp_time > 0:
+        O.bodies[platen].state.vel = (0, 0, 0)     # at rest until the first advance()
     return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H,
-                   axial_stress=axial_stress, axial_strain=axial_strain)
+                   axial_stress=axial_stress, axial_strain=axial_strain, advance=advance)
