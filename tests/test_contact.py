@@ -343,13 +343,15 @@ def test_uniaxial_builder_ramp_and_end_caps():
     from yade import O
     from yade_mpm import cases
     l, speed, ramp, caps = 0.005, 1.0, 2e-5, 2
-    e0_free = ym.get(cases.uniaxial_flaw("intact", l, side_room=4 * l)[0], "eps0")       # no caps: the rock's thresholds
+    def eps0(solver):                                  # ε_D⁰ by particle id
+        return solver.view("eps0")[ym.id_order(solver)].copy()
+    e0_free = eps0(cases.uniaxial_flaw("intact", l, side_room=4 * l)[0])       # no caps: the rock's thresholds
     s, sc = cases.uniaxial_flaw("intact", l, platen_speed=speed, ramp_time=ramp, end_cap_cells=caps, side_room=4 * l)
     p = O.bodies[sc["platen"]]
     assert p.state.vel[1] == 0.0
     y0, H = p.state.pos[1], sc["height"]
     x = ym.get(s, "pos")
-    e0 = ym.get(s, "eps0")
+    e0 = eps0(s)
     cap = (x[:, 1] < caps * l) | (x[:, 1] > H - caps * l)
     assert cap.sum() == 2 * 2 * caps * (sc["width"] / (l / 2)) and np.all(e0[cap] == 0.99)
     assert np.all(e0[~cap] == e0_free[~cap]) and np.all(e0_free < 0.99)
