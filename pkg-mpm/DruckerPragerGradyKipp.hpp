@@ -139,7 +139,6 @@ struct ReturnInfo {
 
 template <int D>
 struct DruckerPragerGradyKipp {
-	static constexpr bool hasDamage = true;
 	DpGkMat mat;
 	Real    K, G, M, qphi, kphi, qpsi, cFloor, epsFloor, H, alpha13, cg, E, nu;
 	Real    cell; // grid spacing l [m] (threshold readings that depend on it)

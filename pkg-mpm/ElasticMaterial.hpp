@@ -29,7 +29,6 @@ inline void elasticTrial(Sym<D>& s, const Sym<D>& de, Real K, Real G)
 // Material kernel for purely elastic scenes: no state, no plasticity, no damage work.
 template <int D>
 struct LinearElastic {
-	static constexpr bool hasDamage = false;
 	Real K, G;
 	explicit LinearElastic(const ElasticMat& m) : K(m.bulk()), G(m.shear()) { }
 

@@ -185,11 +185,6 @@ struct Grid {
 		planes.push_back(p);
 		rebuildPlanes();
 	}
-	void clearPlanes()
-	{
-		planes.clear();
-		rebuildPlanes();
-	}
 	bool hasMirrors() const { return !mirrors.empty(); }
 	static const char* kindName(BoundaryKind k) { return k == BoundaryKind::Fixed ? "fixed" : k == BoundaryKind::Slip ? "slip" : "slip-onesided"; }
 

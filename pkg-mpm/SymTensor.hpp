@@ -44,12 +44,6 @@ struct Sym {
 		d.toDeviator();
 		return std::sqrt(0.5 * d.contract());
 	}
-	bool finite() const
-	{
-		for (int k = 0; k < N; ++k)
-			if (!std::isfinite(c[k])) return false;
-		return true;
-	}
 	Eigen::Matrix3d full() const
 	{
 		Eigen::Matrix3d m;

@@ -11,18 +11,6 @@
 
 namespace mpm {
 
-// Cubic B-spline kernel w̃(t), Eq. 13 (t in cells).
-inline Real bspline3(Real t)
-{
-	t = std::abs(t);
-	if (t < 1) return 0.5 * t * t * t - t * t + 2.0 / 3.0;
-	if (t < 2) {
-		Real u = 2 - t;
-		return u * u * u / 6.0;
-	}
-	return 0;
-}
-
 template <int D>
 struct Stencil {
 	static constexpr int N = Dim<D>::nStencil;
