@@ -81,6 +81,7 @@ struct Grid {
 		int                 axis, side, twoP;
 		std::vector<size_t> columns; // linear index of the first node (coordinate 0 along axis) of every node line along axis
 		NodeLanes           sign;    // +1, except −1 on the lanes of the normal momentum/force components
+		int                 nPairs = 0, pairK[3], pairKp[3]; // node lines within 2 cells on the material side and their partners
 	};
 	std::vector<Mirror> mirrors;
 
@@ -205,6 +206,10 @@ struct Grid {
 			m.sign[2 + p.axis] = m.sign[2 + D + p.axis] = -1;
 			for (size_t i = 0; i < s; ++i)
 				if (coords(i)[p.axis] == 0) m.columns.push_back(i);
+			for (int k = 0; k < stored[p.axis]; ++k) {
+				const int d2 = -m.side * (2 * k - m.twoP), kp = m.twoP - k; // ≥ 0 on the material side (half cells)
+				if (d2 >= 0 && d2 < 4 && kp >= 0 && kp < stored[p.axis] && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
+			}
 			mirrors.push_back(std::move(m));
 		}
 		std::fill(fixMask.begin(), fixMask.end(), 0);
@@ -346,13 +351,7 @@ private:
 	template <class F>
 	void forPairs(const Mirror& m, F&& f) const
 	{
-		for (int k = 0; k < stored[m.axis]; ++k) {
-			const int d2 = -m.side * (2 * k - m.twoP); // ≥ 0 on the material side (half cells)
-			if (d2 < 0 || d2 >= 4) continue;
-			const int kp = m.twoP - k;
-			if (kp < 0 || kp >= stored[m.axis]) continue;
-			f(k, kp);
-		}
+		for (int j = 0; j < m.nPairs; ++j) f(m.pairK[j], m.pairKp[j]);
 	}
 	// Stored coordinate k along axis a lies beyond a symmetry plane within 2 cells, with its partner inside
 	// the physical grid.

@@ -4,6 +4,7 @@
   bar      fixed–free bar period vs 4L/c at L/l = 20, 40, 80 ('fixed' = one-sided WLS on a node line)
   kirsch   circular opening (cases.circular_opening): quarter model with two symmetry planes vs the full
            model at the same grid and the same number of steps: L2 errors along θ = 0°, 90° and wall time
+  cost     step time of the tunnel-like scene (arch opening, l = 1 mm): no planes, 4 'slip', 4 'slip-onesided'
   crack    plot of the line-crack centre-opening convergence from scripts/penny_crack.py outputs
            (--crack-dirs out/crack_c0.2,out/crack_c0.3 made with --parts convergence --half-length c)
 
@@ -22,24 +23,10 @@ import yade_mpm.output as out
 from yade_mpm import cases, kirsch
 
 
-def uniform_block(dim, axis, side, kind, cells=8, h=0.1, sigma=-40e6, steps=300):
-    """Max relative error of σ_nn and max spurious component / |σ| after `steps` damped steps of a block
-    under uniform σ_nn on a plane at its face `side` along `axis` (opposite face: consistent traction)."""
-    W = cells * h
-    lo, hi = np.zeros(dim), np.full(dim, W)
-    s = ym.make_solver(lo, hi, h, margin=2)
-    mat = ym.ElasticMat(**ym.rocks.GRANITE)
-    ym.add_region(s, mat, lo, hi, ppc=2)
-    st = np.zeros(len(ym.SYM_NAMES[dim]))
-    st[axis] = sigma
-    if dim == 2:
-        st[2] = mat.poisson * sigma
-    ym.set_initial_stress(s, st)
-    n = np.zeros(dim)
-    n[axis] = -side
-    ym.apply_face_traction(s, axis, -side, W if side < 0 else 0.0, sigma * n, 2)
-    s.addBoundaryPlane(axis, side, 0.0 if side < 0 else W, kind)
-    s.damping = 0.1
+def uniform_block(dim, axis, side, kind, h=0.1, sigma=-40e6, steps=300):
+    """Max relative error of σ_nn, max spurious component / |σ| and row means after `steps` damped steps of
+    cases.uniform_stress_block."""
+    s = cases.uniform_stress_block(dim, axis, side, kind, spacing=h, sigma=sigma)
     t0 = time.time()
     s.run(steps)
     wall = time.time() - t0
@@ -80,26 +67,8 @@ def part_slip(a):
 
 
 def fixed_free_period(cells_x):
-    L, cy = 1.0, 2
-    h = L / cells_x
-    s = ym.Solver2D((-2 * h, 0.0), h, (cells_x + 4, cy))
-    m = ym.ElasticMat(young=1e9, poisson=0.25, density=1000.0)
-    ym.add_region(s, m, (0.0, 0.0), (L, cy * h), ppc=2)
-    s.addBoundaryPlane(0, -1, 0.0, "fixed")
-    s.addBoundaryPlane(1, -1, 0.0, "slip")
-    s.addBoundaryPlane(1, 1, cy * h, "slip")
-    s.view("v0")[:] = 0.01 * np.sin(np.pi * s.view("x0") / (2 * L))
-    s.requestSort()
-    T = 4 * L / np.sqrt((m.bulk() + 4 * m.shear() / 3) / m.density)
-    t, q = [], []
-    while s.time < 2.3 * T:
-        s.step()
-        t.append(s.time)
-        q.append(np.sum(s.view("mass") * s.view("v0") * np.sin(np.pi * s.view("x0") / (2 * L))))
-    t, q = np.array(t), np.array(q)
-    k = np.nonzero((q[:-1] > 0) & (q[1:] <= 0))[0]
-    tz = t[k] + (t[k + 1] - t[k]) * q[k] / (q[k] - q[k + 1])
-    return float(np.mean(np.diff(tz)) / T - 1)
+    s, T, shape = cases.fixed_free_bar(cells_x)
+    return cases.mode_period(s, shape, 2.3 * T) / T - 1
 
 
 def part_bar(a):
@@ -183,6 +152,41 @@ def part_crack(a):
     return dict(crack=[dict(half_length_m=r[0], spacing_m=r[1], uy_center_rel_error=r[2], uy_l2_rel_error=r[3]) for r in rows])
 
 
+def tunnel_like(kind, spacing):
+    """The tunnel specimen's geometry (150 mm square, arch opening) at in-situ stress, with 4 planes of
+    `kind` on its sides (None: no planes)."""
+    W = cases.TUNNEL_WIDTH
+    s = ym.make_solver((0, 0), (W, W), spacing, margin=2)
+    ym.add_region(s, ym.ElasticMat(**ym.rocks.GRANITE), (0, 0), (W, W), holes=cases.arch_tunnel_holes())
+    ym.set_initial_stress(s, (-10e6, -20e6, -0.2313 * 30e6, 0))
+    if kind:
+        for axis, side, pos in ((0, -1, 0.0), (0, 1, W), (1, -1, 0.0), (1, 1, W)):
+            s.addBoundaryPlane(axis, side, pos, kind)
+    s.damping = 0.1
+    return s
+
+
+def part_cost(a):
+    """Step time of the tunnel-like scene without planes, with 4 'slip' planes (images) and with 4
+    'slip-onesided' planes, interleaved repeats in one process (ratios only)."""
+    kinds = (None, "slip", "slip-onesided")
+    solvers = {k: tunnel_like(k, a.cost_spacing) for k in kinds}
+    for s in solvers.values():
+        s.run(20)                                          # warm-up (first sort, page faults)
+    times = {k: [] for k in kinds}
+    for _ in range(a.cost_repeats):
+        for k in kinds:
+            t0 = time.perf_counter()
+            solvers[k].run(a.cost_steps)
+            times[k].append((time.perf_counter() - t0) / a.cost_steps)
+    best = {str(k): min(v) for k, v in times.items()}
+    res = dict(particles=solvers[None].numParticles, spacing=a.cost_spacing, step_s=best,
+               ratio_slip=best["slip"] / best["None"], ratio_onesided=best["slip-onesided"] / best["None"])
+    print(f"cost (tunnel-like, {res['particles']} particles, l = {a.cost_spacing} m, best of {a.cost_repeats}×{a.cost_steps} steps): "
+          f"no planes {1e3 * best['None']:.2f} ms/step, 4 slip {res['ratio_slip']:.3f}×, 4 slip-onesided {res['ratio_onesided']:.3f}×", flush=True)
+    return dict(cost=res)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True, help="output directory (CSV, PNG, summary.json)")
@@ -190,22 +194,31 @@ def main(argv=None):
     ap.add_argument("--kirsch-spacing", type=float, default=0.04, help="grid spacing of the Kirsch comparison [m]")
     ap.add_argument("--kirsch-steps", type=int, default=3000, help="steps of each Kirsch model (the same for both)")
     ap.add_argument("--crack-dirs", default="out/crack_c0.2,out/crack_c0.3", help="penny_crack.py output directories (crack part)")
+    ap.add_argument("--cost-spacing", type=float, default=0.001, help="grid spacing of the cost scene [m] (tunnel: 0.001)")
+    ap.add_argument("--cost-steps", type=int, default=50, help="steps per timed repeat of the cost part")
+    ap.add_argument("--cost-repeats", type=int, default=5, help="interleaved repeats of the cost part")
     ap.add_argument("--threads", type=int, default=1, help="OpenMP threads")
     a = ap.parse_args(argv)
     parts = set(a.parts.split(","))
-    if not parts <= {"slip", "bar", "kirsch", "crack"}:
-        ap.error(f"--parts: unknown part in {a.parts}; allowed slip, bar, kirsch, crack")
+    if not parts <= {"slip", "bar", "kirsch", "crack", "cost"}:
+        ap.error(f"--parts: unknown part in {a.parts}; allowed slip, bar, kirsch, crack, cost")
+    if not (a.cost_spacing > 0 and a.cost_steps >= 1 and a.cost_repeats >= 1):
+        ap.error("--cost-spacing must be > 0 m, --cost-steps and --cost-repeats ≥ 1")
     if not (0 < a.kirsch_spacing <= cases.OPENING_RADIUS):
         ap.error(f"--kirsch-spacing must lie in (0, {cases.OPENING_RADIUS}] m")
     if a.kirsch_steps < 1:
         ap.error("--kirsch-steps must be ≥ 1")
     ym.setThreads(a.threads)
     os.makedirs(a.out, exist_ok=True)
+    path = os.path.join(a.out, "boundaries_summary.json")
     summary = {}
-    for name, fn in (("slip", part_slip), ("bar", part_bar), ("kirsch", part_kirsch), ("crack", part_crack)):
+    if os.path.exists(path):                      # parts run separately accumulate in one summary
+        with open(path) as f:
+            summary = json.load(f)
+    for name, fn in (("slip", part_slip), ("bar", part_bar), ("kirsch", part_kirsch), ("crack", part_crack), ("cost", part_cost)):
         if name in parts:
             summary.update(fn(a))
-    with open(os.path.join(a.out, "boundaries_summary.json"), "w") as f:
+    with open(path, "w") as f:
         json.dump(summary, f, indent=1)
     return summary
 

@@ -9,28 +9,12 @@ MAT = ym.rocks.GRANITE
 GAP = ym._core.exclusionBits["gap"]
 
 
-def _block_on_plane(dim, axis, side, kind="slip", cells=6, h=0.1, sigma=-40e6, steps=80):
-    """Block [0, W]^dim under a uniform normal stress σ along `axis`, resting on a plane at its face `side`;
-    the opposite face carries the consistent traction σ·n, the lateral faces are free."""
-    W = cells * h
-    lo, hi = np.zeros(dim), np.full(dim, W)
-    s = ym.make_solver(lo, hi, h, margin=2)
-    mat = ym.ElasticMat(**MAT)
-    ym.add_region(s, mat, lo, hi, ppc=2)
-    st = np.zeros(len(ym.SYM_NAMES[dim]))
-    st[axis] = sigma
-    if dim == 2:
-        st[2] = mat.poisson * sigma                       # plane strain σzz of the uniaxial state
-    ym.set_initial_stress(s, st)
-    n = np.zeros(dim)
-    n[axis] = -side                                       # outward normal of the loaded (opposite) face
-    ym.apply_face_traction(s, axis, -side, W if side < 0 else 0.0, sigma * n, 2)
-    s.addBoundaryPlane(axis, side, 0.0 if side < 0 else W, kind)
-    s.damping = 0.1
+def _block_on_plane(dim, axis, side, steps):
+    s = ym.cases.uniform_stress_block(dim, axis, side, cells=6, sigma=-40e6)
     s.run(steps)
     sg = ym.get(s, "stress")
     others = [k for k in range(sg.shape[1]) if k != axis and not (dim == 2 and k == 2)]
-    return np.abs(sg[:, axis] / sigma - 1).max(), np.abs(sg[:, others] / sigma).max()
+    return np.abs(sg[:, axis] / -40e6 - 1).max(), np.abs(sg[:, others] / 40e6).max()
 
 
 @pytest.mark.parametrize("dim,axis,side", [(2, a, s) for a in range(2) for s in (-1, 1)] + [(3, a, s) for a in range(3) for s in (-1, 1)])
@@ -42,25 +26,8 @@ def test_uniform_stress_on_a_slip_plane_is_exact(dim, axis, side):
 
 
 def _fixed_free_period(cells_x):
-    L, cy = 1.0, 2
-    h = L / cells_x
-    s = ym.Solver2D((-2 * h, 0.0), h, (cells_x + 4, cy))
-    m = ym.ElasticMat(young=1e9, poisson=0.25, density=1000.0)
-    ym.add_region(s, m, (0.0, 0.0), (L, cy * h), ppc=2)
-    s.addBoundaryPlane(0, -1, 0.0, "fixed")               # x = L is free
-    s.addBoundaryPlane(1, -1, 0.0, "slip")
-    s.addBoundaryPlane(1, 1, cy * h, "slip")
-    set_velocity(s, lambda x: np.column_stack([0.01 * np.sin(np.pi * x[:, 0] / (2 * L)), 0 * x[:, 0]]))
-    T = 4 * L / np.sqrt((m.bulk() + 4 * m.shear() / 3) / m.density)   # first mode of a fixed–free bar
-    t, q = [], []
-    while s.time < 1.3 * T:                           # two downward zero crossings of the mode
-        s.step()
-        t.append(s.time)
-        q.append(np.sum(s.view("mass") * s.view("v0") * np.sin(np.pi * s.view("x0") / (2 * L))))
-    t, q = np.array(t), np.array(q)
-    k = np.nonzero((q[:-1] > 0) & (q[1:] <= 0))[0]
-    tz = t[k] + (t[k + 1] - t[k]) * q[k] / (q[k] - q[k + 1])
-    return np.mean(np.diff(tz)) / T - 1
+    s, T, shape = ym.cases.fixed_free_bar(cells_x)
+    return ym.cases.mode_period(s, shape, 1.3 * T) / T - 1     # two downward zero crossings of the mode
 
 
 def test_fixed_free_bar_period_second_order():

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from . import rocks
+from .materials import ElasticMat
 from .geometry import Box, Circle, rotated_rectangle
 from .scene import add_region, apply_face_traction, apply_traction, get, make_solver, set_initial_stress
 
@@ -419,3 +420,59 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         O.bodies[platen].state.vel = (0, 0, 0)     # at rest until the first advance()
     return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H,
                    axial_stress=axial_stress, axial_strain=axial_strain, advance=advance)
+
+
+# ------------------------------------------------------------------------------------------------
+# Boundary checks (doc/boundaries.md)
+def uniform_stress_block(dim, axis, side, kind="slip", cells=8, spacing=0.1, sigma=-40e6, damping=0.1, material=None):
+    """Block [0, cells·l]^dim under a uniform normal stress σ [Pa] along `axis` (every particle starts at it),
+    resting on a boundary plane of `kind` at its face `side` (−1 low, +1 high); the opposite face carries the
+    consistent traction σ·n, the lateral faces are free: an exact equilibrium. material: default granite."""
+    mat = material or rocks.granite()
+    W = cells * spacing
+    lo, hi = np.zeros(dim), np.full(dim, W)
+    s = make_solver(lo, hi, spacing, margin=2)
+    add_region(s, mat, lo, hi, ppc=2)
+    st = np.zeros(4 if dim == 2 else 6)
+    st[axis] = sigma
+    if dim == 2:
+        st[2] = mat.poisson * sigma                     # plane-strain σzz of the uniaxial state
+    set_initial_stress(s, st)
+    n = np.zeros(dim)
+    n[axis] = -side                                     # outward normal of the loaded (opposite) face
+    apply_face_traction(s, axis, -side, W if side < 0 else 0.0, sigma * n, 2)
+    s.addBoundaryPlane(axis, side, 0.0 if side < 0 else W, kind)
+    s.damping = damping
+    return s
+
+
+def fixed_free_bar(cells_x, length=1.0, cells_y=2, material=None, amplitude=0.01):
+    """Bar [0, L] × [0, cells_y·l] fixed at x = 0 ('fixed' plane), free at x = L, between slip planes in y
+    (1D strain), moving in its first mode v_x = a sin(πx/2L). Returns (solver, T = 4L/c_p [s], mode shape)."""
+    h = length / cells_x
+    s = make_solver((0.0, 0.0), (length, cells_y * h), h, margin=2)
+    m = material or ElasticMat(young=1e9, poisson=0.25, density=1000.0)
+    add_region(s, m, (0.0, 0.0), (length, cells_y * h), ppc=2)
+    s.addBoundaryPlane(0, -1, 0.0, "fixed")
+    s.addBoundaryPlane(1, -1, 0.0, "slip")
+    s.addBoundaryPlane(1, 1, cells_y * h, "slip")
+    shape = lambda x: np.sin(np.pi * x / (2 * length))
+    s.view("v0")[:] = amplitude * shape(s.view("x0"))
+    s.requestSort()
+    return s, 4 * length / np.sqrt((m.bulk() + 4 * m.shear() / 3) / m.density), shape
+
+
+def mode_period(solver, shape, t_end):
+    """Mean period [s] of the modal momentum q = Σ m v_x shape(x) between its downward zero crossings
+    (linearly interpolated), stepping `solver` to `t_end` [s]."""
+    t, q = [], []
+    while solver.time < t_end:
+        solver.step()
+        t.append(solver.time)
+        q.append(np.sum(solver.view("mass") * solver.view("v0") * shape(solver.view("x0"))))
+    t, q = np.array(t), np.array(q)
+    k = np.nonzero((q[:-1] > 0) & (q[1:] <= 0))[0]
+    if len(k) < 2:
+        raise ValueError(f"t_end = {t_end} s holds fewer than two downward zero crossings of the mode")
+    tz = t[k] + (t[k + 1] - t[k]) * q[k] / (q[k] - q[k + 1])
+    return float(np.mean(np.diff(tz)))
