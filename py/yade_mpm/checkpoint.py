@@ -96,10 +96,6 @@ def _particle_arrays(solver):
     return out
 
 
-def _material_dict(m):
-    return {a: getattr(m, a) for a in dir(m) if not a.startswith("_") and not callable(getattr(m, a))}
-
-
 def _digest(*arrays):
     h = hashlib.sha256()
     for a in arrays:
@@ -119,7 +115,7 @@ def solver_fingerprint(solver):
             "arrays": sorted(k for k in arrs if k not in ("id", "material")),
             "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
             "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver.materialKinds],
-            "materials": [_material_dict(solver.material(i)) for i in range(solver.numMaterials)],
+            "materials": [solver.material(i).toDict() for i in range(solver.numMaterials)],
             "material_index": _digest(arrs["material"][order])}
 
 
