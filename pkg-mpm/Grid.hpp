@@ -14,36 +14,18 @@
 //
 // Boundary planes (axis-aligned):
 //   Slip          symmetry plane by reflected images: the nodes within 2 cells beyond the plane carry the
-//                 mirror image of their partners (fold/unfold, below), so every particle sees the nodal field
-//                 of the symmetric full-space problem (exact for uniform states and linear fields; interior
-//                 closed-form stencils). Position on a node line or halfway between two.
+//                 mirror image of their partners (fold/unfold, MirrorPlanes.hpp), so every particle sees the
+//                 nodal field of the symmetric full-space problem. Position on a node line or halfway between two.
 //   Fixed         one-sided WLS: nodes strictly beyond are excluded (ExBeyond), nodes on the plane have all
 //                 velocity components zero; the WLS fit over the active nodes is exact for linear fields that
 //                 vanish on the plane. Position on a node line.
 //   SlipOneSided  as Fixed but only the normal component is zero on the plane (kept to compare costs).
 #pragma once
-#include "MpmTypes.hpp"
+#include "MirrorPlanes.hpp"
 #include <algorithm>
 #include <vector>
 
 namespace mpm {
-
-// One node: lumped mass (Eq. 20), Shepard mass Σ w m (Eq. 17 denominator) and two vector slots reused
-// within a step: a = momentum → updated velocity, b = force → MUSL velocity.
-// A node fills one 64-byte cache line (2D: 6 values + 2 padding lanes, 3D: 8 values), so the transfer
-// kernels update a whole node with one 8-lane vector operation (lanes: m, mw, a…, b…, padding).
-template <int D>
-struct alignas(64) Node {
-	Real m, mw;
-	Real a[D];
-	Real b[D];
-};
-typedef Real NodeLanes __attribute__((vector_size(64), may_alias));
-static_assert(sizeof(Node<2>) == sizeof(NodeLanes) && sizeof(Node<3>) == sizeof(NodeLanes), "a node must fill one lane vector");
-template <int D>
-inline NodeLanes& lanes(Node<D>& n) { return *reinterpret_cast<NodeLanes*>(&n); }
-template <int D>
-inline const NodeLanes& lanes(const Node<D>& n) { return *reinterpret_cast<const NodeLanes*>(&n); }
 
 enum class BoundaryKind : int { Fixed = 0, Slip = 1, SlipOneSided = 2 };
 
@@ -76,14 +58,7 @@ struct Grid {
 	std::vector<BoundaryPlane<D>> planes;
 	Vec allowedLo, allowedHi; // particles must stay in [allowedLo, allowedHi): the physical grid cut by the planes
 
-	// A symmetry plane in stored index units: node line k pairs with k' = twoP − k.
-	struct Mirror {
-		int                 axis, side, twoP;
-		std::vector<size_t> columns; // linear index of the first node (coordinate 0 along axis) of every node line along axis
-		NodeLanes           sign;    // +1, except −1 on the lanes of the normal momentum/force components
-		int                 nPairs = 0, pairK[3], pairKp[3]; // node lines within 2 cells on the material side and their partners
-	};
-	std::vector<Mirror> mirrors;
+	MirrorPlanes<D> mirrors; // the Slip planes (fold/unfold of the reflected images)
 
 	Grid() = default;
 	Grid(const Vec& o, Real h, const IVec& n) { init(o, h, n); }
@@ -199,25 +174,14 @@ struct Grid {
 			const int twoP = int(std::lround(2 * (p.position - origin[p.axis]) / spacing)) + 2 * ghost;
 			if (p.side < 0) allowedLo[p.axis] = std::max(allowedLo[p.axis], p.position);
 			else allowedHi[p.axis] = std::min(allowedHi[p.axis], p.position);
-			if (p.kind != BoundaryKind::Slip) continue;
-			Mirror m;
-			m.axis = p.axis, m.side = p.side, m.twoP = twoP;
-			for (int l = 0; l < 8; ++l) m.sign[l] = 1;
-			m.sign[2 + p.axis] = m.sign[2 + D + p.axis] = -1;
-			for (size_t i = 0; i < s; ++i)
-				if (coords(i)[p.axis] == 0) m.columns.push_back(i);
-			for (int k = 0; k < stored[p.axis]; ++k) {
-				const int d2 = -m.side * (2 * k - m.twoP), kp = m.twoP - k; // ≥ 0 on the material side (half cells)
-				if (d2 >= 0 && d2 < 4 && kp >= 0 && kp < stored[p.axis] && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
-			}
-			mirrors.push_back(std::move(m));
+			if (p.kind == BoundaryKind::Slip) mirrors.add(*this, p.axis, p.side, twoP);
 		}
 		std::fill(fixMask.begin(), fixMask.end(), 0);
 		for (size_t i = 0; i < s; ++i) {
 			const IVec c   = coords(i);
 			uint8_t    bit = excluded[i] & ~uint8_t(ExGhost | ExBeyond);
 			for (int a = 0; a < D; ++a)
-				if ((c[a] < ghost || c[a] > cells[a] + ghost) && !mirroredAlong(a, c[a])) bit |= ExGhost;
+				if ((c[a] < ghost || c[a] > cells[a] + ghost) && !mirrors.mirroredAlong(a, c[a])) bit |= ExGhost;
 			for (const auto& p : planes) {
 				const int twoP = int(std::lround(2 * (p.position - origin[p.axis]) / spacing)) + 2 * ghost;
 				const int d2   = p.side * (2 * c[p.axis] - twoP); // > 0: beyond the plane, = 0: on it
@@ -264,80 +228,12 @@ struct Grid {
 	// Any excluded node in the stencil whose first node is `base` (one load; the kernels' branch).
 	bool stencilHasExcluded(size_t base) const { return stencilExcl[base] != 0; }
 
-	// ------------------------------------------------------------------ symmetry planes: fold / unfold
-	// A particle next to a symmetry plane has a reflected image beyond it. The image's contribution to node k
-	// equals the reflection of the particle's own contribution to the partner node k' = twoP − k (cubic
-	// B-splines are even; mass and the tangential components are even, the normal components odd), so after a
-	// scatter every node on the material side within 2 cells adds the reflected content of its partner
-	// (fold), and afterwards every node beyond takes the reflection of its partner (unfold): the nodal field
-	// is then exactly that of the mirror-symmetric full-space problem. Both are orphaned OpenMP loops over
-	// the node lines along the plane's axis (called inside the step's parallel region; each line is handled
-	// by one thread in a fixed order → bitwise identical results for any thread count). Planes are folded
-	// in order and unfolded in reverse order, so corners of two planes get all reflected images.
-	// `mask`: 1 on the lanes to fold (all after P2G; the MUSL momentum lanes after G2P).
-	void foldMirrors(const NodeLanes& mask)
-	{
-		for (const auto& m : mirrors) {
-			const NodeLanes ms = mask * m.sign;
-			const size_t    st = stride[m.axis];
-			const long      nc = long(m.columns.size());
-#pragma omp for schedule(static)
-			for (long c = 0; c < nc; ++c) {
-				const size_t col = m.columns[size_t(c)];
-				forPairs(m, [&](int k, int kp) { lanes(nodes[col + size_t(k) * st]) += ms * lanes(nodes[col + size_t(kp) * st]); });
-			}
-		}
-	}
-	void unfoldMirrors()
-	{
-		for (auto it = mirrors.rbegin(); it != mirrors.rend(); ++it) {
-			const auto&  m  = *it;
-			const size_t st = stride[m.axis];
-			const long   nc = long(m.columns.size());
-#pragma omp for schedule(static)
-			for (long c = 0; c < nc; ++c) {
-				const size_t col = m.columns[size_t(c)];
-				forPairs(m, [&](int k, int kp) {
-					if (k != kp) lanes(nodes[col + size_t(kp) * st]) = m.sign * lanes(nodes[col + size_t(k) * st]);
-				});
-			}
-		}
-	}
-	// The same reflection for per-node arrays kept outside Node<D> (the contact phase's nodal forces):
-	// f(k, kp, axis) for every (material-side node k, partner kp) of every symmetry plane, in plane order,
-	// k == kp on the plane. Serial (call from one thread).
+	// ------------------------------------------------------------------ symmetry planes (MirrorPlanes.hpp)
+	void foldMirrors(const NodeLanes& mask) { mirrors.fold(nodes, mask); }
+	void unfoldMirrors() { mirrors.unfold(nodes); }
 	template <class F>
-	void forEachMirrorPair(F&& f) const
-	{
-		for (const auto& m : mirrors)
-			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * stride[m.axis], col + size_t(kp) * stride[m.axis], m.axis); });
-	}
-	// Share of node i in the modelled region: 0 for a node beyond a symmetry plane (an image), 1/2 for each
-	// symmetry plane it lies on (its content includes the reflected half), else 1. Reactions on bodies sum
-	// nodal forces with this weight.
-	Real mirrorShare(size_t i) const
-	{
-		Real       s = 1;
-		const IVec c = coords(i);
-		for (const auto& m : mirrors) {
-			const int d2 = m.side * (2 * c[m.axis] - m.twoP);
-			if (d2 > 0) return 0;
-			if (d2 == 0) s *= 0.5;
-		}
-		return s;
-	}
-	static NodeLanes allLanes()
-	{
-		NodeLanes l;
-		for (int i = 0; i < 8; ++i) l[i] = 1;
-		return l;
-	}
-	static NodeLanes secondVectorLanes() // lanes b (MUSL momentum)
-	{
-		NodeLanes l = {};
-		for (int a = 0; a < D; ++a) l[2 + D + a] = 1;
-		return l;
-	}
+	void forEachMirrorPair(F&& f) const { mirrors.forEachPair(f); }
+	Real mirrorShare(size_t i) const { return mirrors.share(coords(i)); } // weight of node i in body reactions
 
 private:
 	static std::string num(Real v)
@@ -346,55 +242,13 @@ private:
 		snprintf(b, sizeof(b), "%g", v);
 		return b;
 	}
-	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
-	// including the line on the plane (k == kp).
-	template <class F>
-	void forPairs(const Mirror& m, F&& f) const
-	{
-		for (int j = 0; j < m.nPairs; ++j) f(m.pairK[j], m.pairKp[j]);
-	}
-	// Stored coordinate k along axis a lies beyond a symmetry plane within 2 cells, with its partner inside
-	// the physical grid.
-	bool mirroredAlong(int a, int k) const
-	{
-		for (const auto& m : mirrors) {
-			if (m.axis != a) continue;
-			const int d2 = m.side * (2 * k - m.twoP);
-			const int kp = m.twoP - k;
-			if (d2 > 0 && d2 < 4 && kp >= ghost && kp <= cells[a] + ghost) return true;
-		}
-		return false;
-	}
 	// The node whose content node i mirrors (i itself when i is not an image).
-	size_t partnerOf(size_t i) const
-	{
-		if (mirrors.empty()) return i;
-		IVec c = coords(i);
-		for (int r = 0; r < 3; ++r) // an image of an image (corner): repeat until on the material side
-			for (const auto& m : mirrors) {
-				const int d2 = m.side * (2 * c[m.axis] - m.twoP);
-				if (d2 > 0 && d2 < 4) c[m.axis] = m.twoP - c[m.axis];
-			}
-		return linear(c);
-	}
+	size_t partnerOf(size_t i) const { return mirrors.empty() ? i : linear(mirrors.partner(coords(i))); }
 	// Node i and all its images across the symmetry planes (corners included).
 	template <class F>
 	void forImages(size_t i, F&& f) const
 	{
-		size_t list[8] = { i };
-		int    n       = 1;
-		for (const auto& m : mirrors) {
-			const int cur = n;
-			for (int j = 0; j < cur; ++j) {
-				IVec      c  = coords(list[j]);
-				const int d2 = -m.side * (2 * c[m.axis] - m.twoP);
-				if (d2 > 0 && d2 < 4) {
-					c[m.axis] = m.twoP - c[m.axis];
-					if (c[m.axis] >= 0 && c[m.axis] < stored[m.axis] && n < 8) list[n++] = linear(c);
-				}
-			}
-		}
-		for (int j = 0; j < n; ++j) f(list[j]);
+		mirrors.forImages(coords(i), [&](const IVec& c) { f(linear(c)); });
 	}
 	void writeBits(size_t i, uint8_t bits, bool on)
 	{

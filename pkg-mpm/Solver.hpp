@@ -165,7 +165,7 @@ public:
 #pragma omp parallel
 			{
 				xfer.p2g(mat, g, s, errP2G);
-				if (mirrors) grid.foldMirrors(Grid<D>::allLanes()); // symmetry planes: add the reflected images
+				if (mirrors) grid.foldMirrors(MirrorPlanes<D>::allLanes()); // symmetry planes: add the reflected images
 				stamp(t[1]);
 				if (errP2G.none()) {
 					gridUpdate(grid, dt, damping, massFloor);
@@ -179,7 +179,7 @@ public:
 					if (errContact.none()) {
 						xfer.g2p(errG2P);
 						if (errG2P.none()) {
-							if (mirrors) grid.foldMirrors(Grid<D>::secondVectorLanes());
+							if (mirrors) grid.foldMirrors(MirrorPlanes<D>::secondVectorLanes());
 							gridMusl(grid, massFloor);
 							if (mirrors) grid.unfoldMirrors();
 						}

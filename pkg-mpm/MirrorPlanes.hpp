@@ -1,0 +1,175 @@
+// Symmetry ('slip') boundary planes by reflected images (doc/boundaries.md).
+//
+// A particle next to a symmetry plane has a reflected image beyond it. The image's contribution to node k
+// equals the reflection of the particle's own contribution to the partner node k' = twoP − k (cubic
+// B-splines are even; mass and the tangential components are even, the normal components odd), so after a
+// scatter every node on the material side within 2 cells adds the reflected content of its partner
+// (fold), and afterwards every node beyond takes the reflection of its partner (unfold): the nodal field
+// is then exactly that of the mirror-symmetric full-space problem (exact for uniform states and linear
+// fields; interior closed-form stencils).
+// fold/unfold are orphaned OpenMP loops over the node lines along the plane's axis (called inside the
+// step's parallel region; each line is handled by one thread in a fixed order → bitwise identical
+// results for any thread count). Planes are folded in order and unfolded in reverse order, so corners of
+// two planes get all reflected images. Node coordinates here are stored (ghost-shifted) indices.
+#pragma once
+#include "GridNode.hpp"
+#include <vector>
+
+namespace mpm {
+
+template <int D>
+class MirrorPlanes {
+public:
+	using IVec = typename Dim<D>::IVec;
+
+	// A symmetry plane in stored index units: node line k pairs with k' = twoP − k.
+	struct Mirror {
+		int                 axis, side, twoP;
+		size_t              stride;        // linear-index stride along axis
+		int                 nStored;       // stored nodes along axis
+		int                 physLo, physHi; // stored index range of the physical nodes along axis
+		std::vector<size_t> columns;       // linear index of the first node (coordinate 0 along axis) of every node line along axis
+		NodeLanes           sign;          // +1, except −1 on the lanes of the normal momentum/force components
+		int                 nPairs = 0, pairK[3], pairKp[3]; // node lines within 2 cells on the material side and their partners
+	};
+
+	bool empty() const { return list.empty(); }
+	void clear() { list.clear(); }
+	// The plane along `axis` with material on `side` (-1: above, +1: below) at stored half-index twoP,
+	// on grid g (Grid<D>: size, coords, stride, stored, cells, ghost).
+	template <class G>
+	void add(const G& g, int axis, int side, int twoP)
+	{
+		Mirror m;
+		m.axis = axis, m.side = side, m.twoP = twoP;
+		m.stride = g.stride[axis], m.nStored = g.stored[axis];
+		m.physLo = G::ghost, m.physHi = g.cells[axis] + G::ghost;
+		for (int l = 0; l < 8; ++l) m.sign[l] = 1;
+		m.sign[2 + axis] = m.sign[2 + D + axis] = -1;
+		for (size_t i = 0; i < g.size(); ++i)
+			if (g.coords(i)[axis] == 0) m.columns.push_back(i);
+		for (int k = 0; k < m.nStored; ++k) {
+			const int d2 = -side * (2 * k - twoP), kp = twoP - k; // ≥ 0 on the material side (half cells)
+			if (d2 >= 0 && d2 < 4 && kp >= 0 && kp < m.nStored && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
+		}
+		list.push_back(std::move(m));
+	}
+
+	// Fold after a scatter: nodes within 2 cells on the material side add their partner's reflection.
+	// `mask`: 1 on the lanes to fold (all after P2G; the MUSL momentum lanes after G2P).
+	void fold(std::vector<Node<D>>& nodes, const NodeLanes& mask) const
+	{
+		for (const auto& m : list) {
+			const NodeLanes ms = mask * m.sign;
+			const long      nc = long(m.columns.size());
+#pragma omp for schedule(static)
+			for (long c = 0; c < nc; ++c) {
+				const size_t col = m.columns[size_t(c)];
+				forPairs(m, [&](int k, int kp) { lanes(nodes[col + size_t(k) * m.stride]) += ms * lanes(nodes[col + size_t(kp) * m.stride]); });
+			}
+		}
+	}
+	// Unfold: every node beyond a plane takes the reflection of its partner (planes in reverse order).
+	void unfold(std::vector<Node<D>>& nodes) const
+	{
+		for (auto it = list.rbegin(); it != list.rend(); ++it) {
+			const auto& m  = *it;
+			const long  nc = long(m.columns.size());
+#pragma omp for schedule(static)
+			for (long c = 0; c < nc; ++c) {
+				const size_t col = m.columns[size_t(c)];
+				forPairs(m, [&](int k, int kp) {
+					if (k != kp) lanes(nodes[col + size_t(kp) * m.stride]) = m.sign * lanes(nodes[col + size_t(k) * m.stride]);
+				});
+			}
+		}
+	}
+	// The same reflection for per-node arrays kept outside Node<D> (the contact phase's nodal forces):
+	// f(k, kp, axis) with linear indices for every (material-side node k, partner kp) of every plane, in
+	// plane order, k == kp on the plane. Serial (call from one thread).
+	template <class F>
+	void forEachPair(F&& f) const
+	{
+		for (const auto& m : list)
+			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * m.stride, col + size_t(kp) * m.stride, m.axis); });
+	}
+	// Share of the node at c in the modelled region: 0 beyond a plane (an image), 1/2 for each plane it
+	// lies on (its content includes the reflected half), else 1.
+	Real share(const IVec& c) const
+	{
+		Real s = 1;
+		for (const auto& m : list) {
+			const int d2 = m.side * (2 * c[m.axis] - m.twoP);
+			if (d2 > 0) return 0;
+			if (d2 == 0) s *= 0.5;
+		}
+		return s;
+	}
+	// Stored coordinate k along axis a lies beyond a plane within 2 cells, with its partner inside the
+	// physical grid.
+	bool mirroredAlong(int a, int k) const
+	{
+		for (const auto& m : list) {
+			if (m.axis != a) continue;
+			const int d2 = m.side * (2 * k - m.twoP);
+			const int kp = m.twoP - k;
+			if (d2 > 0 && d2 < 4 && kp >= m.physLo && kp <= m.physHi) return true;
+		}
+		return false;
+	}
+	// The node whose content the node at c mirrors (c itself when it is not an image).
+	IVec partner(IVec c) const
+	{
+		for (int r = 0; r < 3; ++r) // an image of an image (corner): repeat until on the material side
+			for (const auto& m : list) {
+				const int d2 = m.side * (2 * c[m.axis] - m.twoP);
+				if (d2 > 0 && d2 < 4) c[m.axis] = m.twoP - c[m.axis];
+			}
+		return c;
+	}
+	// f(c') for the node at c and all its images across the planes (corners included), c first.
+	template <class F>
+	void forImages(const IVec& c0, F&& f) const
+	{
+		IVec list8[8] = { c0 };
+		int  n        = 1;
+		for (const auto& m : list) {
+			const int cur = n;
+			for (int j = 0; j < cur; ++j) {
+				IVec      c  = list8[j];
+				const int d2 = -m.side * (2 * c[m.axis] - m.twoP);
+				if (d2 > 0 && d2 < 4) {
+					c[m.axis] = m.twoP - c[m.axis];
+					if (c[m.axis] >= 0 && c[m.axis] < m.nStored && n < 8) list8[n++] = c;
+				}
+			}
+		}
+		for (int j = 0; j < n; ++j) f(list8[j]);
+	}
+
+	static NodeLanes allLanes()
+	{
+		NodeLanes l;
+		for (int i = 0; i < 8; ++i) l[i] = 1;
+		return l;
+	}
+	static NodeLanes secondVectorLanes() // lanes b (MUSL momentum)
+	{
+		NodeLanes l = {};
+		for (int a = 0; a < D; ++a) l[2 + D + a] = 1;
+		return l;
+	}
+
+private:
+	std::vector<Mirror> list;
+
+	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
+	// including the line on the plane (k == kp).
+	template <class F>
+	static void forPairs(const Mirror& m, F&& f)
+	{
+		for (int j = 0; j < m.nPairs; ++j) f(m.pairK[j], m.pairKp[j]);
+	}
+};
+
+} // namespace mpm
