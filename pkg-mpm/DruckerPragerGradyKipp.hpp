@@ -282,7 +282,8 @@ struct DruckerPragerGradyKipp {
 			if (mat.plasticity) plasticReturn(s, P.epsP[p]);
 			return;
 		}
-		updatePoint(s, de, P.epsP[p], P.damage[p], P.eps0[p], dt, mat.flawCount > 0 ? &P.nFlaw[p] : nullptr, P.vol0[p], P.id[p]);
+		if (mat.flawCount > 0) updatePoint(s, de, P.epsP[p], P.damage[p], P.eps0[p], dt, &P.nFlaw[p], P.vol0[p], P.id[p]);
+		else updatePoint(s, de, P.epsP[p], P.damage[p], P.eps0[p], dt); // vol0 and id are read only by the flaw population
 	}
 	Sym<D> forceStress(const Particles<D>& P, size_t p) const { return damaged(P.stress(p), P.damage[p]); }
 };

@@ -61,10 +61,21 @@ public:
 	}
 	size_t add(const ElasticMat& m) { return push({ MaterialKind::Elastic, (m.validate(), m), DpGkMat {} }); }
 	size_t add(const DpGkMat& m) { return push({ MaterialKind::DruckerPragerGradyKipp, (m.validate(), ElasticMat(m)), m }); }
-	void   replaceFirst(const Entry& e)
+	// The only material of a one-material scene, replaced by m (Solver::setMaterial, older scripts), with
+	// every particle's damage threshold recomputed; a scene with several materials refuses (it would
+	// silently change other regions). Checked before any change.
+	template <class Mat>
+	void replaceOnly(const Mat& m, Particles<D>& P)
 	{
-		list.at(0) = e;
+		if (!single())
+			throw InputError("setMaterial: this solver holds " + std::to_string(size())
+			                 + " materials; setMaterial replaces the only material of a one-material scene — use addMaterial and addParticles(…, material=index)");
+		m.validate();
+		if constexpr (std::is_same_v<Mat, DpGkMat>) m.checkThresholds(P.vol0.data(), P.n, cell, D); // ε_D⁰ ∈ (0, 1) before anything changes
+		if constexpr (std::is_same_v<Mat, DpGkMat>) list[0] = { MaterialKind::DruckerPragerGradyKipp, ElasticMat(m), m };
+		else list[0] = { MaterialKind::Elastic, m, DpGkMat {} };
 		rebuild();
+		if (anyDpgk() && P.n) P.ensureDamageState(), initDamageThresholds(P, 0);
 	}
 	// Material index given through the public API: an integer in [0, size()) (0 allowed before any material exists).
 	void checkIndex(long i) const
@@ -121,11 +132,35 @@ public:
 	// material is DP–GK with damage on; allocates the activated-flaw counts when a material has flaws.
 	void initDamageThresholds(Particles<D>& P, size_t from) const
 	{
-		for (const auto& e : list)
-			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage && e.dpgk.flawCount > 0 && P.nFlaw.size() != P.n) P.nFlaw.assign(P.n, 0.0);
+		ensureFlawCounts(P);
 		for (size_t p = from; p < P.n; ++p) {
 			const Entry& e = of(P, p);
 			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage) P.eps0[p] = initialThreshold(e.dpgk, P.vol0[p], cell, D, P.id[p]);
+		}
+	}
+	// Particle slots `slots` take material index `material` (Solver::setParticleMaterial) and that
+	// material's ε_D⁰ (Eq. 37 with its V reading; 0 where it has no damage) with no
+	// activated flaws; damage and plastic strain stay (the particle's history). Checked before any change:
+	// the index, every slot in [0, n) and every threshold in (0, 1).
+	void assign(Particles<D>& P, const std::vector<size_t>& slots, long material) const
+	{
+		if (list.empty()) throw InputError("setParticleMaterial: no material in this solver yet; add one with addMaterial");
+		checkIndex(material);
+		std::vector<Real> vol0;
+		for (size_t p : slots) {
+			if (p >= P.n) throw InputError("setParticleMaterial: particle index " + std::to_string(p) + " is outside the allowed range [0, " + std::to_string(P.n) + ")");
+			vol0.push_back(P.vol0[p]);
+		}
+		const Entry& e = list[size_t(material)];
+		if (e.kind == MaterialKind::DruckerPragerGradyKipp) e.dpgk.checkThresholds(vol0.data(), vol0.size(), cell, D);
+		for (size_t p : slots) P.mat[p] = uint8_t(material);
+		if (!anyDpgk()) return;
+		P.ensureDamageState();
+		ensureFlawCounts(P);
+		const bool threshold = e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
+		for (size_t p : slots) {
+			P.eps0[p] = threshold ? initialThreshold(e.dpgk, P.vol0[p], cell, D, P.id[p]) : 0.0;
+			if (!P.nFlaw.empty()) P.nFlaw[p] = 0;
 		}
 	}
 	// Grid spacing l [m]: the V readings and the regularised threshold of Eq. 37 depend on it.
@@ -140,6 +175,11 @@ private:
 	Real               cell = 0; // grid spacing l [m]
 	MixedMaterial<D>   mixed; // kernels of a mixed scene, rebuilt when the list changes (never while stepping)
 
+	void ensureFlawCounts(Particles<D>& P) const // activated-flaw counts, allocated when a material has flaws
+	{
+		for (const auto& e : list)
+			if (e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage && e.dpgk.flawCount > 0 && P.nFlaw.size() != P.n) P.nFlaw.assign(P.n, 0.0);
+	}
 	size_t push(const Entry& e)
 	{
 		if (list.size() >= 256) throw InputError("addMaterial: a solver holds at most 256 materials (particle material index is 8-bit)");

@@ -34,7 +34,7 @@ public:
 	};
 
 	bool empty() const { return list.empty(); }
-	void clear() { list.clear(); }
+	void clear() { list.clear(), groups.clear(); }
 	// The plane along `axis` with material on `side` (-1: above, +1: below) at stored half-index twoP,
 	// on grid g (Grid<D>: size, coords, stride, stored, cells, ghost).
 	template <class G>
@@ -53,34 +53,40 @@ public:
 			if (d2 >= 0 && d2 < 4 && kp >= 0 && kp < m.nStored && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
 		}
 		list.push_back(std::move(m));
+		const Mirror& added = list.back();
+		if (groups.empty() || list[groups.back().first].axis != axis) groups.push_back({ list.size() - 1, 0, {}, {}, {} });
+		Group& g2 = groups.back();
+		for (int j = 0; j < added.nPairs; ++j) g2.k[g2.n] = added.pairK[j], g2.kp[g2.n] = added.pairKp[j], g2.sign[g2.n++] = added.sign;
 	}
 
 	// Fold after a scatter: nodes within 2 cells on the material side add their partner's reflection.
 	// `mask`: 1 on the lanes to fold (all after P2G; the MUSL momentum lanes after G2P).
 	void fold(std::vector<Node<D>>& nodes, const NodeLanes& mask) const
 	{
-		for (const auto& m : list) {
-			const NodeLanes ms = mask * m.sign;
-			const long      nc = long(m.columns.size());
+		for (const auto& g : groups) {
+			const Mirror& m = list[g.first];
+			NodeLanes     ms[6];
+			for (int e = 0; e < g.n; ++e) ms[e] = mask * g.sign[e];
+			const long nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				const size_t col = m.columns[size_t(c)];
-				forPairs(m, [&](int k, int kp) { lanes(nodes[col + size_t(k) * m.stride]) += ms * lanes(nodes[col + size_t(kp) * m.stride]); });
+				Node<D>* col = &nodes[m.columns[size_t(c)]];
+				for (int e = 0; e < g.n; ++e) lanes(col[size_t(g.k[e]) * m.stride]) += ms[e] * lanes(col[size_t(g.kp[e]) * m.stride]);
 			}
 		}
 	}
 	// Unfold: every node beyond a plane takes the reflection of its partner (planes in reverse order).
 	void unfold(std::vector<Node<D>>& nodes) const
 	{
-		for (auto it = list.rbegin(); it != list.rend(); ++it) {
-			const auto& m  = *it;
-			const long  nc = long(m.columns.size());
+		for (auto it = groups.rbegin(); it != groups.rend(); ++it) {
+			const Group&  g  = *it;
+			const Mirror& m  = list[g.first];
+			const long    nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				const size_t col = m.columns[size_t(c)];
-				forPairs(m, [&](int k, int kp) {
-					if (k != kp) lanes(nodes[col + size_t(kp) * m.stride]) = m.sign * lanes(nodes[col + size_t(k) * m.stride]);
-				});
+				Node<D>* col = &nodes[m.columns[size_t(c)]];
+				for (int e = g.n - 1; e >= 0; --e)
+					if (g.k[e] != g.kp[e]) lanes(col[size_t(g.kp[e]) * m.stride]) = g.sign[e] * lanes(col[size_t(g.k[e]) * m.stride]);
 			}
 		}
 	}
@@ -162,6 +168,16 @@ public:
 
 private:
 	std::vector<Mirror> list;
+	// Consecutive planes along the same axis (the two sides of a block, ≥ 2 cells apart) touch disjoint
+	// node lines in fold and unfold except for adding to the same node in plane order, so they share one
+	// loop over the node lines (one barrier per pass): bitwise the same as plane after plane.
+	struct Group {
+		size_t    first; // its first plane in list (columns, stride)
+		int       n;     // (k, kp) pairs of all its planes, in plane order
+		int       k[6], kp[6];
+		NodeLanes sign[6];
+	};
+	std::vector<Group> groups;
 
 	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
 	// including the line on the plane (k == kp).

@@ -48,61 +48,79 @@ inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRe
 	return rmin;
 }
 
-// x ← x + Δt v (the G2P velocity). Checks that the particle stays finite and on the grid (else err) and
-// within the cells its block may reach before a re-sort (BlockSchedule::reach): *drift is set when one
-// left them, so the deterministic colouring stays valid. Returns max ‖v‖ (for Δt).
+
+// The messages of moveParticles for the particles of [p0, p1) that failed (rare; positions already moved).
+template <int D>
+inline void recordMoveFailures(const Particles<D>& P, const Grid<D>& grid, uint32_t p0, uint32_t p1, ErrorRecord& err)
+{
+	const auto lo = grid.origin, hi = grid.upper(), alo = grid.allowedLo, ahi = grid.allowedHi;
+	for (uint32_t pp = p0; pp < p1; ++pp) {
+		const size_t p  = pp;
+		Real         sp = 0, check = 0;
+		for (int a = 0; a < D; ++a) sp += P.v[a][p] * P.v[a][p], check += P.x[a][p];
+		if (!(std::isfinite(check) && std::isfinite(sp))) {
+			std::string what = "has a non-finite position";
+			for (int a = D - 1; a >= 0; --a)
+				if (!std::isfinite(P.v[a][p])) what = "has non-finite velocity component " + std::to_string(a) + " = " + fmtNum(P.v[a][p]);
+			err.record(p, what);
+			continue;
+		}
+		for (int a = 0; a < D; ++a)
+			if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
+				err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (grid spans [" + fmtNum(lo[a]) + ", "
+				                      + fmtNum(hi[a]) + ") m)");
+				break;
+			} else if (P.x[a][p] < alo[a] || P.x[a][p] >= ahi[a]) {
+				err.record(p, "crossed a boundary plane along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (allowed: ["
+				                      + fmtNum(alo[a]) + ", " + fmtNum(ahi[a]) + ") m)");
+				break;
+			}
+	}
+}
+
+// x ← x + Δt v (the G2P velocity). Checks that the particle stays finite and on the grid cut by the boundary
+// planes (else err) and within the cells its block may reach before a re-sort (BlockSchedule::reach):
+// *drift is set when one left them, so the deterministic colouring stays valid. Returns max ‖v‖ (for Δt).
+// Per block a tight loop over the arrays without branches; the messages are built only when a particle failed.
 template <int D>
 inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool& driftOut)
 {
-	Particles<D>&  P      = tr.P;
-	const Grid<D>& grid   = tr.grid;
+	Particles<D>&  P    = tr.P;
+	const Grid<D>& grid = tr.grid;
 	const auto&    blocks = tr.sched.start;
 	const long     nb     = long(blocks.size()) - 1;
-	const auto     lo = grid.origin, hi = grid.upper();
-	const auto     alo = grid.allowedLo, ahi = grid.allowedHi; // the grid cut by the boundary planes
-	const Real     invH  = 1.0 / grid.spacing;
-	Real           v2max = 0;
-	bool           drift = false;
-#pragma omp parallel for schedule(dynamic, 4) reduction(max : v2max) reduction(|| : drift)
+	Real           lo[D], alo[D], ahi[D];
+	Real*          x[D];
+	const Real*    v[D];
+	for (int a = 0; a < D; ++a) {
+		lo[a] = grid.origin[a], alo[a] = grid.allowedLo[a], ahi[a] = grid.allowedHi[a]; // the grid cut by the boundary planes
+		x[a] = P.x[a].data(), v[a] = P.v[a].data();
+	}
+	const Real invH  = 1.0 / grid.spacing;
+	Real       v2max = 0;
+	int        drift = 0;
+#pragma omp parallel for schedule(dynamic, 4) reduction(max : v2max) reduction(| : drift)
 	for (long b = 0; b < nb; ++b) {
 		Real cellLo[D], cellHi[D]; // cells a particle of block b may reach before a re-sort
 		tr.sched.reach(size_t(b), cellLo, cellHi);
-		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
-			const size_t p  = pp;
-			Real         sp = 0, check = 0;
-			bool         inside = true, near = true;
+		int bad = 0;
+		for (uint32_t p = blocks[b]; p < blocks[b + 1]; ++p) {
+			Real sp = 0, check = 0;
+			int  out = 0, far = 0;
 			for (int a = 0; a < D; ++a) {
-				const Real va = P.v[a][p], xa = P.x[a][p] + dt * va;
-				P.x[a][p] = xa;
+				const Real va = v[a][p], xa = x[a][p] + dt * va;
+				x[a][p] = xa;
 				sp += va * va;
 				check += xa;
-				inside = inside && xa >= alo[a] && xa < ahi[a];
+				out |= !(xa >= alo[a] && xa < ahi[a]);
 				const Real f = (xa - lo[a]) * invH;
-				near = near && f >= cellLo[a] && f < cellHi[a];
+				far |= !(f >= cellLo[a] && f < cellHi[a]);
 			}
-			if (!(std::isfinite(check) && std::isfinite(sp))) {
-				std::string what = "has a non-finite position";
-				for (int a = D - 1; a >= 0; --a)
-					if (!std::isfinite(P.v[a][p])) what = "has non-finite velocity component " + std::to_string(a) + " = " + fmtNum(P.v[a][p]);
-				err.record(p, what);
-				continue;
-			}
-			if (!inside) {
-				for (int a = 0; a < D; ++a)
-					if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
-						err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (grid spans ["
-						                      + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m)");
-						break;
-					} else if (P.x[a][p] < alo[a] || P.x[a][p] >= ahi[a]) {
-						err.record(p, "crossed a boundary plane along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (allowed: ["
-						                      + fmtNum(alo[a]) + ", " + fmtNum(ahi[a]) + ") m)");
-						break;
-					}
-				continue;
-			}
+			bad |= out | !(check - check == 0 && sp - sp == 0); // y − y ≠ 0: y is NaN or ±inf
+			drift |= far;
 			v2max = std::max(v2max, sp);
-			drift = drift || !near;
 		}
+		if (bad) recordMoveFailures(P, grid, blocks[b], blocks[b + 1], err);
 	}
 	driftOut = drift;
 	return std::sqrt(v2max);

@@ -40,7 +40,11 @@ public:
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
 
-	size_t          liveViews = 0; // arrays handed out without copy (NumPy views, binding layer): appending must not move them
+	// Arrays handed out without copy (NumPy views, binding layer): appending must not move them, and P2G
+	// checks what they may have changed (reach, mass, volume) while one is alive or was taken since the step.
+	size_t liveViews = 0;
+	void   viewOpened() { ++liveViews, viewTaken = true; }
+	void   viewClosed() { --liveViews; }
 
 	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { materials.setCell(grid.spacing); }
 	Solver(const Solver&)            = delete; // xfer refers to the members
@@ -89,15 +93,14 @@ public:
 	void setMaterial(const Mat& m)
 	{
 		if (materials.size() == 0) return void(addMaterial(m));
-		if (!materials.single())
-			throw InputError("setMaterial: this solver holds " + std::to_string(materials.size())
-			                 + " materials; setMaterial replaces the only material of a one-material scene — use addMaterial and addParticles(…, material=index)");
-		m.validate();
-		if constexpr (std::is_same_v<Mat, DpGkMat>) m.checkThresholds(P.vol0.data(), P.n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything changes
-		if constexpr (std::is_same_v<Mat, DpGkMat>) materials.replaceFirst({ MaterialKind::DruckerPragerGradyKipp, ElasticMat(m), m });
-		else materials.replaceFirst({ MaterialKind::Elastic, m, DpGkMat {} });
-		if (materials.anyDpgk() && P.n) P.ensureDamageState(), materials.initDamageThresholds(P, 0);
+		materials.replaceOnly(m, P);
 		needCheck = true;
+	}
+	// Particle slots `slots` take material index `material` with that material's damage threshold ε_D⁰.
+	void setParticleMaterial(const std::vector<size_t>& slots, long material)
+	{
+		materials.assign(P, slots, material);
+		needCheck = true; // ρ/M of a mixed scene's time step depends on the particle's material
 	}
 	const MaterialSet<D>& materialSet() const { return materials; }
 	MaterialKind          materialKind() const { return materials.size() ? materials[0].kind : MaterialKind::None; } // of material 0
@@ -119,17 +122,9 @@ public:
 
 	// ---------------------------------------------------------------- time step
 	// Characteristic P-wave speed v_c = max over materials of √((K + 4G/3)/ρ_min) [m/s].
-	Real waveSpeed()
-	{
-		prepare();
-		return materials.waveSpeed(rhoMin);
-	}
+	Real waveSpeed() { return prepare(), materials.waveSpeed(rhoMin); }
 	// Paper's stability condition Δt = C·l/(v_c + max‖v‖) with the current particle velocities.
-	Real stableDt()
-	{
-		prepare();
-		return courant * grid.spacing / (waveSpeed() + vmax);
-	}
+	Real stableDt() { return prepare(), courant * grid.spacing / (waveSpeed() + vmax); }
 	// One step with the automatic Δt (autoDt) or fixedDt.
 	void step()
 	{
@@ -155,6 +150,7 @@ public:
 		ContactStep<D> cs { xfer, dt, time, massFloor, errContact };
 		const bool     withContact = contact.active();
 		const bool     mirrors     = grid.hasMirrors(); // symmetry planes: fold/unfold the reflected images
+		const bool     viewWrites  = liveViews > 0 || viewTaken; // P2G checks what views may have changed
 		if (withContact) contact.beforeTransfer(cs);
 		const Vec  g = gravity;
 		const Real s = loadScale(time);
@@ -164,7 +160,7 @@ public:
 			// on shared cores); every thread takes the same branches after the barrier ending each phase.
 #pragma omp parallel
 			{
-				xfer.p2g(mat, g, s, errP2G);
+				xfer.p2g(mat, g, s, viewWrites, errP2G);
 				if (mirrors) grid.foldMirrors(MirrorPlanes<D>::allLanes()); // symmetry planes: add the reflected images
 				stamp(t[1]);
 				if (errP2G.none()) {
@@ -188,6 +184,7 @@ public:
 				stamp(t[4]);
 			}
 			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
+			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
 			ErrorRecord err;
 			const Real  rmin = updateStress(xfer, mat, dt, err);
@@ -252,6 +249,7 @@ private:
 	Transfer<D>      xfer;               // the transfers, bound to grid, P and sched
 	bool             needSort  = true;   // particles must be re-sorted by block before the next transfer
 	bool             needCheck = true;   // particle data changed from outside: validate and refresh ρ_min, mass floor
+	bool             viewTaken = true;   // a view was handed out since the last accepted P2G
 	Real             vmax = 0, rhoMin = INFINITY, massFloor = 0;
 	ErrorRecord      errP2G, errContact, errG2P; // shared by the threads of the transfer region
 	std::string      failure;                    // message of a step that failed with particles partly updated

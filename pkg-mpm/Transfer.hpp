@@ -57,8 +57,16 @@ public:
 	// P0 = [m, m, m v, f_ext] and A_b = [0, 0, m C_·b, −V σ_·b 3/l²] (interior particles, where
 	// ∇ψ_i = w_i 3/l² (x_i − x_p)); particles with a general WLS stencil go through the full ψ, ∇ψ.
 	// Sign of Eq. 21 in code: stress is tension-positive and f_int,i = −Σ_p V_p σ_p ∇ψ_i(x_p).
-	// loadScale multiplies the particle surface forces (traction ramp).
+	// loadScale multiplies the particle surface forces (traction ramp). viewWrites: state may have been
+	// written through NumPy views since the last step, so positions are checked against their block's
+	// reach and mass and volume against (0, inf) (compile-time: a step without views pays nothing).
 	template <class Mat>
+	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, bool viewWrites, ErrorRecord& err)
+	{
+		if (viewWrites) p2g<true>(mat, gravity, loadScale, err);
+		else p2g<false>(mat, gravity, loadScale, err);
+	}
+	template <bool checkViews, class Mat>
 	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, ErrorRecord& err)
 	{
 		auto& nodes = grid.nodes;
@@ -69,21 +77,22 @@ public:
 		const Real invH = 1.0 / grid.spacing;
 		scatterBlocks([&](uint32_t blk) {
 			Real cellLo[D], cellHi[D]; // cells a particle of this block may reach: beyond, the colouring breaks
-			sched.reach(blk, cellLo, cellHi);
+			if constexpr (checkViews) sched.reach(blk, cellLo, cellHi);
 			forBlock(blk, [&](size_t p) {
 				Kernel<D> k;
 				kernelOf(p, k);
 				if (!k.inside) return err.record(p, "has a position outside the grid or not finite: " + positionText(p));
 				const Real m = P.mass[p], V = P.vol[p];
-				// State written through the views without requestSort() is refused before it is used.
-				for (int a = 0; a < D; ++a) {
-					const Real f = (P.x[a][p] - grid.origin[a]) * invH;
-					if (!(f >= cellLo[a] && f < cellHi[a]))
-						return err.record(p, "at " + positionText(p) + " lies beyond the cells its block may reach before a re-sort "
-						                     "(moved through a view?): call solver.requestSort() after writing positions");
+				if constexpr (checkViews) { // state written through the views without requestSort() is refused before it is used
+					for (int a = 0; a < D; ++a) {
+						const Real f = (P.x[a][p] - grid.origin[a]) * invH;
+						if (!(f >= cellLo[a] && f < cellHi[a]))
+							return err.record(p, "at " + positionText(p) + " lies beyond the cells its block may reach before a re-sort "
+							                     "(moved through a view?): call solver.requestSort() after writing positions");
+					}
+					if (!(m > 0 && m < INFINITY)) return err.record(p, "has mass m = " + fmtNum(m) + " kg, must be finite and > 0 (written through a view?)");
+					if (!(V > 0 && V < INFINITY)) return err.record(p, "has volume V = " + fmtNum(V) + " m³, must be finite and > 0 (written through a view?)");
 				}
-				if (!(m > 0 && m < INFINITY)) return err.record(p, "has mass m = " + fmtNum(m) + " kg, must be finite and > 0 (written through a view?)");
-				if (!(V > 0 && V < INFINITY)) return err.record(p, "has volume V = " + fmtNum(V) + " m³, must be finite and > 0 (written through a view?)");
 				const Sym<D> sg = mat.forceStress(P, p);
 				Real         mv[D], mC[D][D], fe[D];
 				for (int a = 0; a < D; ++a) {

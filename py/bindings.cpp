@@ -140,24 +140,38 @@ struct SolverWrap {
 		np::ndarray m = asDoubleArray(mass, "masses", 0, n);
 		s.addParticles(reinterpret_cast<double*>(x.get_data()), reinterpret_cast<double*>(v.get_data()), reinterpret_cast<double*>(m.get_data()), n, mat);
 	}
-	static void setForces(S& s, bp::object idx, bp::object forces)
+	// A 1-D array of particle slots (storage order), each ≥ 0; the callee checks the upper bound.
+	static std::vector<size_t> slotsArg(bp::object idx, const char* what)
 	{
 		bp::object  raw  = bp::import("numpy").attr("asarray")(idx);
 		std::string kind = bp::extract<std::string>(raw.attr("dtype").attr("kind"));
 		if (bp::len(raw.attr("shape")) != 1 || (kind != "i" && kind != "u" && bp::len(raw) > 0))
-			throw InputError(who("setParticleForces: indices") + " must be a 1-D array of integer particle slots (got " + pyTypeName(idx.ptr()) + " " + pyRepr(idx) + ")");
+			throw InputError(who(what) + " must be a 1-D array of integer particle slots (got " + pyTypeName(idx.ptr()) + " " + pyRepr(idx) + ")");
 		if (bp::len(raw) == 0) raw = raw.attr("astype")("int64"); // [] is float64 to NumPy
-		np::ndarray i = np::from_object(raw, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
-		size_t      n = i.shape(0);
-		np::ndarray f = asDoubleArray(forces, "forces", D, n);
+		np::ndarray i  = np::from_object(raw, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
 		auto*       ip = reinterpret_cast<int64_t*>(i.get_data());
-		auto*       fp = reinterpret_cast<double*>(f.get_data());
-		for (size_t k = 0; k < n; ++k) {
+		std::vector<size_t> slots(size_t(i.shape(0)));
+		for (size_t k = 0; k < slots.size(); ++k) {
 			if (ip[k] < 0) throw InputError("particle index " + std::to_string(ip[k]) + " is negative");
+			slots[k] = size_t(ip[k]);
+		}
+		return slots;
+	}
+	static void setForces(S& s, bp::object idx, bp::object forces)
+	{
+		const auto  slots = slotsArg(idx, "setParticleForces: indices");
+		np::ndarray f     = asDoubleArray(forces, "forces", D, slots.size());
+		auto*       fp    = reinterpret_cast<double*>(f.get_data());
+		for (size_t k = 0; k < slots.size(); ++k) {
 			typename Dim<D>::Vec fv;
 			for (int a = 0; a < D; ++a) fv[a] = fp[k * D + a];
-			s.setParticleForce(size_t(ip[k]), fv);
+			s.setParticleForce(slots[k], fv);
 		}
+	}
+	static void setParticleMaterial(S& s, bp::object idx, bp::object material)
+	{
+		const auto slots = slotsArg(idx, "setParticleMaterial: indices");
+		s.setParticleMaterial(slots, argInt(material, who("setParticleMaterial: material"), 0, 255));
 	}
 	static void addPlane(S& s, bp::object axisO, bp::object sideO, bp::object posO, bp::object kindO)
 	{
@@ -195,8 +209,11 @@ struct SolverWrap {
 		if (name == "epsP") f = &P.epsP;
 		if (name == "damage") f = &P.damage;
 		if (name == "eps0") f = &P.eps0;
-		if (name == "material") // checked at the next step (requestSort); ε_D⁰ (eps0) is not recomputed
-			return np::from_data(P.mat.data(), np::dtype::get_builtin<uint8_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(uint8_t)), viewOwner(self));
+		if (name == "material") { // read-only: setParticleMaterial changes it with the damage threshold ε_D⁰
+			np::ndarray m = np::from_data(P.mat.data(), np::dtype::get_builtin<uint8_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(uint8_t)), viewOwner(self));
+			m.attr("setflags")(false);
+			return m;
+		}
 		if (name == "nFlaw") f = &P.nFlaw;
 		if (name == "id")
 			return np::from_data(P.id.data(), np::dtype::get_builtin<int64_t>(), bp::make_tuple(P.n), bp::make_tuple(sizeof(int64_t)), viewOwner(self));
@@ -530,8 +547,8 @@ struct SolverWrap {
 	// arrays under them (Solver::liveViews).
 	struct ViewOwner {
 		std::shared_ptr<S> s;
-		explicit ViewOwner(std::shared_ptr<S> solver) : s(std::move(solver)) { ++s->liveViews; }
-		~ViewOwner() { --s->liveViews; }
+		explicit ViewOwner(std::shared_ptr<S> solver) : s(std::move(solver)) { s->viewOpened(); }
+		~ViewOwner() { s->viewClosed(); }
 	};
 	static bp::object viewOwner(bp::object self) { return bp::object(std::make_shared<ViewOwner>(bp::extract<std::shared_ptr<S>>(self)())); }
 
@@ -552,6 +569,10 @@ struct SolverWrap {
 		        .def("setMaterial", &setMaterial, bp::arg("material"))
 		        .def("addBoundaryPlane", &addPlane, (bp::arg("axis"), bp::arg("side"), bp::arg("position"), bp::arg("kind")))
 		        .def("setParticleForces", &setForces, (bp::arg("indices"), bp::arg("forces")))
+		        .def("setParticleMaterial", &setParticleMaterial, (bp::arg("indices"), bp::arg("material")),
+		             "Particle slots `indices` (storage order, as the views) take material index `material` (addMaterial's return value, "
+		             "range [0, numMaterials - 1]) and that material's damage threshold eps0 (Eq. 37; 0 without damage), with no activated "
+		             "flaws; damage and plastic strain stay. The view 'material' is read-only: use this.")
 		        .def("step", static_cast<void (S::*)()>(&S::step))
 		        .def("advance", &advance, bp::arg("dt"))
 		        .def("run", &run, bp::arg("steps"))

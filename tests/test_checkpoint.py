@@ -86,17 +86,59 @@ def test_solver_only_resume_is_bitwise(tmp_path):
         s.view("v0")[:] = 3 * np.sin(20 * s.view("x1"))
         s.requestSort()
         return s
+    _assert_resume_bitwise(make, 30, 13, tmp_path / "s.ckpt")
+
+
+def _assert_resume_bitwise(make, n, split, path, before_load=lambda b, c: None):
+    """make() run n steps in one go vs split steps, saved (solver only), a fresh make() loaded (after
+    before_load(saved solver, fresh solver)) and the rest: every particle array and the clock bitwise."""
     a = make()
-    a.run(30)
+    a.run(n)
     b = make()
-    b.run(13)
-    checkpoint.save(tmp_path / "s.ckpt", solvers=b, yade=False)
+    b.run(split)
+    checkpoint.save(path, solvers=b, yade=False)
     c = make()
-    checkpoint.load(tmp_path / "s.ckpt", solvers=c)
-    c.run(17)
+    before_load(b, c)
+    checkpoint.load(path, solvers=c)
+    c.run(n - split)
     for k, v in ym.views(a).items():
         np.testing.assert_array_equal(v, ym.views(c)[k], err_msg=k)
-    assert (a.time, a.steps, a.lastDt) == (c.time, c.steps, c.lastDt)
+    assert (a.time, a.steps, a.lastDt) == (c.time, c.steps, c.lastDt) and a.settings() == c.settings()
+    return c
+
+
+def test_two_material_resume_is_bitwise_and_restores_every_setting(tmp_path):
+    """Rock with a grout inclusion: the storage order after the sorts differs from the fresh build, so the
+    material index (a read-only view) is restored through setParticleMaterial with the saved thresholds.
+    Every setting of Solver.settings() (the one declaration) comes back from the checkpoint."""
+    def make():
+        s = ym.make_solver((0, 0), (0.2, 0.1), 0.01)
+        ym.add_region(s, ym.rocks.granite_dpgk(), (0, 0), (0.2, 0.1), holes=[ym.Circle((0.1, 0.05), 0.02)])
+        ym.add_region(s, ym.rocks.cement_grout(), (0.08, 0.03), (0.12, 0.07), keep=lambda x: np.hypot(x[:, 0] - 0.1, x[:, 1] - 0.05) < 0.02)
+        s.addBoundaryPlane(1, -1, 0.0, "fixed")
+        s.gravity, s.sortPeriod, s.damping = (0, -9.81), 5, 0.02
+        s.view("v0")[:] = 30 * (s.view("x0") - 0.1)
+        s.requestSort()
+        return s
+    def other_settings(b, c):
+        assert not np.array_equal(c.view("material"), b.view("material"))   # the sorts moved the grout particles
+        c.gravity, c.damping, c.courant, c.autoDt, c.fixedDt = (1.0, 2.0), 0.3, 0.2, False, 1e-9
+        c.tractionRampTime, c.sortPeriod, c.trackEnergy = 0.5, 3, True
+    _assert_resume_bitwise(make, 24, 11, tmp_path / "m.ckpt", other_settings)
+
+
+def test_old_format_and_other_settings_are_refused(saved, tmp_path):
+    s = build()
+    before = _state(s)
+    old = tmp_path / "old.ckpt"                     # format 1: the settings as a hand-written list
+    _rewrite(saved, old, edit_header=lambda h: h.update(format=1))
+    with pytest.raises(checkpoint.CheckpointError, match=r"format version 1, this yade_mpm reads version 2 only .*rerun from the start"):
+        checkpoint.load(old)
+    other = tmp_path / "other.ckpt"
+    _rewrite(saved, other, edit_header=lambda h: h["settings"]["mpmCk"].update(oldSetting=1.0))
+    with pytest.raises(checkpoint.CheckpointError, match=r"another scene: solver mpmCk: settings \[.*'oldSetting'"):
+        checkpoint.load(other)
+    _assert_same(before, _state(s))
 
 
 def _rewrite(src, dst, edit_header=None, payload=lambda p: p, raw=lambda r: r):

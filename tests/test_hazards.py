@@ -66,6 +66,25 @@ def test_position_moved_past_block_reach_without_request_sort():
     assert s.steps == 2
 
 
+def test_position_written_through_a_view_already_deleted_is_still_checked():
+    """P2G checks reach, mass and volume only while a view is alive or was taken since the last accepted
+    step (a step without views pays nothing): a view deleted before the step still counts, and a refused
+    step does not clear that."""
+    s = _scene(hi=(0.8, 0.4))
+    s.step()
+    p = int(np.argmin(s.view("x0")))
+    pid = int(s.view("id")[p])
+    s.view("x0")[p] = 0.7                             # a temporary view: gone before the step
+    for _ in range(2):                                # refused again: the particle is still out of reach
+        with pytest.raises(ym.MpmSimulationError, match=f"particle id {pid} at .* beyond the cells its block may reach"):
+            s.step()
+    assert s.steps == 1
+    s.requestSort()
+    s.step()
+    s.step()                                          # no view since the last step: the plain P2G
+    assert s.steps == 3
+
+
 def test_bad_mass_through_a_view_names_particle_and_quantity():
     s = _scene()
     s.step()

@@ -99,6 +99,38 @@ def test_regions_keep_their_own_material_and_damage_thresholds():
         s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.25]), material=2)
 
 
+def test_material_view_is_read_only_and_set_particle_material_gives_the_new_threshold():
+    """Writing the material index through the view kept the old ε_D⁰ (a grout particle turned rock kept
+    ε_D⁰ = 0, i.e. damaged at the first tension): the view is read-only, setParticleMaterial sets the index
+    with the new material's Eq. 37 threshold and refuses bad input before any change."""
+    rock = rocks.granite_dpgk()
+    s = ym.make_solver((0, 0), (0.4, 0.2), 0.01)
+    ids_rock = ym.add_region(s, rock, (0, 0), (0.2, 0.2))
+    ids_grout = ym.add_region(s, GROUT, (0.2, 0), (0.4, 0.2))
+    with pytest.raises(ValueError, match="read-only"):
+        s.view("material")[0] = 1
+    slot = np.argsort(s.view("id"))                        # slot of particle id
+    g, r = slot[ids_grout[:5]], slot[ids_rock[:3]]
+    assert np.all(s.view("eps0")[g] == 0)
+    s.setParticleMaterial(g, 0)                            # grout → rock
+    v = (0.01 / 2) ** 3                                    # V = dp³ (default thresholdVolume = 1)
+    assert np.all(s.view("material")[g] == 0)
+    assert np.allclose(s.view("eps0")[g], (v * rock.weibullK) ** (-1 / rock.weibullM), rtol=1e-12)
+    s.setParticleMaterial(r, 1)                            # rock → grout: no damage threshold
+    assert np.all(s.view("material")[r] == 1) and np.all(s.view("eps0")[r] == 0)
+    weak = s.addMaterial(rocks.granite_dpgk(weibullK=1.0))  # V·k < 1: ε_D⁰ > 1, damage could never start
+    before = (s.view("material").copy(), s.view("eps0").copy())
+    for args, msg in (((r, weak), r"damage threshold eps0 .* outside the allowed range \(0, 1\)"),
+                      ((r, 3), r"material = 3 is not a material index of this solver: allowed range \[0, 2\]"),
+                      (([s.numParticles], 0), rf"particle index {s.numParticles} is outside the allowed range"),
+                      (([-1], 0), "particle index -1 is negative"),
+                      (([0.5], 0), "setParticleMaterial: indices must be a 1-D array of integer particle slots")):
+        with pytest.raises(ValueError, match=msg):
+            s.setParticleMaterial(*args)
+    assert np.array_equal(s.view("material"), before[0]) and np.array_equal(s.view("eps0"), before[1])
+    s.step()
+
+
 def test_one_material_scene_runs_the_single_material_path():
     """A one-material scene has one material and every particle index 0 (the compile-time path)."""
     s = ym.make_solver((0, 0), (0.2, 0.2), 0.01)

@@ -10,7 +10,8 @@
 A checkpoint holds, per MPM solver, every particle array in storage order (the particles are sorted
 by block, so the order is state), the clock (time, steps, last Δt), the external work, the block
 schedule of the last sort and the values the next step reads without recomputing them (whether a
-re-sort is due, max‖v‖, ρ_min, the nodal mass floor), plus the solver settings. With YADE it also
+re-sort is due, max‖v‖, ρ_min, the nodal mass floor), plus the solver settings (``Solver.settings()``,
+the one declaration in SolverSettings.hpp). With YADE it also
 holds the YADE scene written by ``O.save`` (bodies and their state, engines, O.time, O.iter, O.dt),
 the body states once more (checked bitwise after ``O.load``) and the state of the Python-side engines
 (``MpmEngine``: the O.dt the user asked for). A run resumed from it is bitwise identical to the
@@ -42,11 +43,9 @@ from . import _core
 from .engine import MpmEngine, _registry as _engines
 from .scene import SYM_NAMES, dim_of
 
-FORMAT = 1
+FORMAT = 2   # 2: solver settings as Solver.settings() in the header (1: a hand-written list)
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
-# Solver settings: state too (a script may change them during a run), restored from the checkpoint.
-_SETTINGS = ("damping", "courant", "fixedDt", "tractionRampTime", "sortPeriod", "autoDt", "trackEnergy")
 
 
 class CheckpointError(ValueError):
@@ -124,12 +123,12 @@ def _solver_state(solver):
     rs = solver.getResumeState()
     arrs["blockStart"] = np.array(rs["blockStart"], copy=True)
     arrs["scalars"] = np.array([float(rs[k]) for k in _STATE_SCALARS], dtype=np.float64)
-    arrs["settings"] = np.array([float(getattr(solver, k)) for k in _SETTINGS], dtype=np.float64)
-    arrs["gravity"] = np.array(solver.gravity, dtype=np.float64)
     return arrs
 
 
-def _restore_solver(solver, arrs):
+def _restore_solver(solver, arrs, settings):
+    """Particle arrays, clock and the other resume state from `arrs`, and the solver settings (state too:
+    a script may change them during a run) from `settings` (``Solver.settings()`` when saved)."""
     sc = dict(zip(_STATE_SCALARS, arrs["scalars"].tolist()))
     for k in ("steps",):
         sc[k] = int(sc[k])
@@ -140,22 +139,22 @@ def _restore_solver(solver, arrs):
     for k in views:                               # shapes were checked before anything was changed
         if views[k].shape != arrs[k].shape:
             raise CheckpointError(f"particle array {k}: shape {arrs[k].shape} in the checkpoint, {views[k].shape} here")
-    old = {k: getattr(solver, k) for k in _SETTINGS}
-    old_g = solver.gravity
-    try:                                          # settings first: all or none
-        for k, v in zip(_SETTINGS, arrs["settings"].tolist()):
-            if v != float(old[k]):
-                setattr(solver, k, type(old[k])(v))
-        solver.gravity = tuple(arrs["gravity"].tolist())
+    old = solver.settings()
+    try:
+        solver.setSettings(settings)              # all or nothing, each value checked against its range
         solver.setResumeState(sc)                 # checks the block schedule before changing anything
     except ValueError as e:
-        for k, v in old.items():
-            if getattr(solver, k) != v:
-                setattr(solver, k, v)
-        solver.gravity = old_g
+        solver.setSettings(old)
         raise CheckpointError(f"checkpoint: {e}") from None
     for k, v in views.items():
-        np.copyto(v, arrs[k])
+        if k != "material":                       # read-only view: set below through the API
+            np.copyto(v, arrs[k])
+    changed = views["material"] != arrs["material"]
+    for m in np.unique(arrs["material"][changed]):
+        solver.setParticleMaterial(np.flatnonzero(changed & (arrs["material"] == m)), int(m))
+    for k in ("eps0", "nFlaw"):                   # the saved values, not the ones recomputed for the new material
+        if changed.any() and k in views:
+            np.copyto(views[k], arrs[k])
 
 
 # -------------------------------------------------------------------------------------- YADE state
@@ -236,9 +235,10 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
         except (TypeError, ValueError) as e:
             raise ValueError(f"{name} must be JSON-serialisable (dicts, lists, numbers, strings): {e}") from None
     arrays, header = {}, {"format": FORMAT, "build": build_id(), "written": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
-                          "meta": meta, "extra": extra, "solvers": {}, "yade": None}
+                          "meta": meta, "extra": extra, "solvers": {}, "settings": {}, "yade": None}
     for name, s in sol.items():
         header["solvers"][name] = solver_fingerprint(s)
+        header["settings"][name] = s.settings()   # JSON floats round-trip exactly
         for k, v in _solver_state(s).items():
             arrays[f"solver/{name}/{k}"] = v
     if with_yade:
@@ -295,7 +295,9 @@ def read(path):
     except ValueError:
         raise CheckpointError(f"checkpoint {path}: corrupted header") from None
     if header.get("format") != FORMAT:
-        raise CheckpointError(f"checkpoint {path}: format version {header.get('format')}, this yade_mpm reads version {FORMAT}")
+        raise CheckpointError(f"checkpoint {path}: format version {header.get('format')}, this yade_mpm reads version {FORMAT} "
+                              "only (checkpoints are not converted between formats: rerun from the start, or resume with the "
+                              "yade_mpm version that wrote it)")
     if header.get("build") != build_id():
         raise CheckpointError(f"checkpoint {path}: written by another build of the yade_mpm core ({header.get('build')}, "
                               f"this one is {build_id()}); a bitwise resume needs the same build — rerun from the start "
@@ -364,6 +366,9 @@ def load(path, solvers=None, yade=None, meta=None):
     problems = []
     for n, s in sol.items():
         problems += _diff(header["solvers"][n], solver_fingerprint(s), f"solver {n}: ")
+        saved, here = sorted(header["settings"][n]), sorted(s.settings())
+        if saved != here:
+            problems.append(f"solver {n}: settings {saved} in the checkpoint, {here} in this core")
     if with_yade:
         here = yade_fingerprint(O)
         if here["bodies"] or here["engines"]:     # a scene was built: it must be the saved one
@@ -372,7 +377,7 @@ def load(path, solvers=None, yade=None, meta=None):
         raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(problems[:8])
                               + (f" (+{len(problems) - 8} more)" if len(problems) > 8 else ""))
     for n, s in sol.items():                      # every check passed: now change the state
-        _restore_solver(s, {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")})
+        _restore_solver(s, {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")}, header["settings"][n])
     if with_yade:
         d = os.path.dirname(os.path.abspath(path))
         tmp = os.path.join(d, f".yade-scene-{os.getpid()}.yade")
