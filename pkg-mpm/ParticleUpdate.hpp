@@ -1,5 +1,6 @@
 // The two particle phases that close a step (paper Fig. 2): the constitutive update from the MUSL
-// velocity gradient, then the position update with the stability and re-sort checks.
+// velocity gradient, then the position update with the stability and re-sort checks (run per block
+// right after the block's stress update).
 #pragma once
 #include "MaterialSet.hpp"
 #include "Transfer.hpp"
@@ -7,17 +8,26 @@
 namespace mpm {
 
 // Velocity gradient from the MUSL nodal velocities (Eq. 7), strain increment (Eq. 29), Jaumann rotation,
-// material update (Eqs. 27–40), volume V ← det(I + Δt∇v) V. Returns the smallest dtDensity (for Δt).
-// Failures (singular fit, non-finite stress, inverted volume) are recorded in err; the caller throws.
-template <int D, class Mat>
-inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRecord& err)
+// material update (Eqs. 27–40), volume V ← det(I + Δt∇v) V, block by block in parallel; after each block
+// after(b, v2max, drift) runs on it (the position update: one parallel loop, the block still in cache).
+// Returns the smallest dtDensity (for Δt) and what `after` reduced (max ‖v‖², drift). Failures (singular
+// fit, non-finite stress, inverted volume) are recorded in err; the caller throws.
+// The particle loop is kept as it is: the compiler's FMA contraction depends on its context, and moving
+// it (e.g. into a per-block function) changed plastic stresses in the last bit.
+struct ParticleStepStats {
+	Real rhoMin = INFINITY, v2max = 0;
+	int  drift  = 0;
+};
+template <int D, class Mat, class After>
+inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRecord& err, After&& after)
 {
 	Particles<D>& P      = tr.P;
 	const auto&   blocks = tr.sched.start;
 	const long    nb     = long(blocks.size()) - 1;
-	Real          rmin   = INFINITY;
-#pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin)
-	for (long b = 0; b < nb; ++b)
+	Real          rmin   = INFINITY, v2max = 0;
+	int           drift  = 0;
+#pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin) reduction(max : v2max) reduction(| : drift)
+	for (long b = 0; b < nb; ++b) {
 		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
 			const size_t p = pp;
 			Real L[D][D] = {};
@@ -45,7 +55,9 @@ inline Real updateStress(const Transfer<D>& tr, const Mat& mat, Real dt, ErrorRe
 			}
 			rmin = std::min(rmin, dtDensity(mat, P, p)); // ρ (one material) or ρ/M (mixed), for Δt
 		}
-	return rmin;
+		after(uint32_t(b), v2max, drift);
+	}
+	return { rmin, v2max, drift };
 }
 
 
@@ -78,52 +90,46 @@ inline void recordMoveFailures(const Particles<D>& P, const Grid<D>& grid, uint3
 	}
 }
 
-// x ← x + Δt v (the G2P velocity). Checks that the particle stays finite and on the grid cut by the boundary
-// planes (else err) and within the cells its block may reach before a re-sort (BlockSchedule::reach):
-// *drift is set when one left them, so the deterministic colouring stays valid. Returns max ‖v‖ (for Δt).
-// Per block a tight loop over the arrays without branches; the messages are built only when a particle failed.
+// x ← x + Δt v (the G2P velocity) for the particles of block b. Checks that each stays finite and on the
+// grid cut by the boundary planes (else err) and within the cells its block may reach before a re-sort
+// (BlockSchedule::reach): drift is set when one left them, so the deterministic colouring stays valid.
+// Raises v2max to the largest ‖v‖² (for Δt). A branch-free loop over the arrays; the messages are built
+// only when a particle failed.
 template <int D>
-inline Real moveParticles(const Transfer<D>& tr, Real dt, ErrorRecord& err, bool& driftOut)
+inline void moveParticles(const Transfer<D>& tr, Real dt, uint32_t b, Real& v2max, int& drift, ErrorRecord& err)
 {
 	Particles<D>&  P    = tr.P;
 	const Grid<D>& grid = tr.grid;
-	const auto&    blocks = tr.sched.start;
-	const long     nb     = long(blocks.size()) - 1;
-	Real           lo[D], alo[D], ahi[D];
+	const uint32_t p0 = tr.sched.start[b], p1 = tr.sched.start[b + 1];
+	Real           lo[D], alo[D], ahi[D], cellLo[D], cellHi[D];
 	Real*          x[D];
 	const Real*    v[D];
+	tr.sched.reach(b, cellLo, cellHi); // cells a particle of block b may reach before a re-sort
 	for (int a = 0; a < D; ++a) {
 		lo[a] = grid.origin[a], alo[a] = grid.allowedLo[a], ahi[a] = grid.allowedHi[a]; // the grid cut by the boundary planes
 		x[a] = P.x[a].data(), v[a] = P.v[a].data();
 	}
-	const Real invH  = 1.0 / grid.spacing;
-	Real       v2max = 0;
-	int        drift = 0;
-#pragma omp parallel for schedule(dynamic, 4) reduction(max : v2max) reduction(| : drift)
-	for (long b = 0; b < nb; ++b) {
-		Real cellLo[D], cellHi[D]; // cells a particle of block b may reach before a re-sort
-		tr.sched.reach(size_t(b), cellLo, cellHi);
-		int bad = 0;
-		for (uint32_t p = blocks[b]; p < blocks[b + 1]; ++p) {
-			Real sp = 0, check = 0;
-			int  out = 0, far = 0;
-			for (int a = 0; a < D; ++a) {
-				const Real va = v[a][p], xa = x[a][p] + dt * va;
-				x[a][p] = xa;
-				sp += va * va;
-				check += xa;
-				out |= !(xa >= alo[a] && xa < ahi[a]);
-				const Real f = (xa - lo[a]) * invH;
-				far |= !(f >= cellLo[a] && f < cellHi[a]);
-			}
-			bad |= out | !(check - check == 0 && sp - sp == 0); // y − y ≠ 0: y is NaN or ±inf
-			drift |= far;
-			v2max = std::max(v2max, sp);
+	const Real invH = 1.0 / grid.spacing;
+	Real       vm = v2max;
+	int        bad = 0, far = 0;
+	for (uint32_t p = p0; p < p1; ++p) {
+		Real sp = 0, check = 0;
+		int  out = 0, nf = 0;
+		for (int a = 0; a < D; ++a) {
+			const Real va = v[a][p], xa = x[a][p] + dt * va;
+			x[a][p] = xa;
+			sp += va * va;
+			check += xa;
+			out |= !(xa >= alo[a] && xa < ahi[a]);
+			const Real f = (xa - lo[a]) * invH;
+			nf |= !(f >= cellLo[a] && f < cellHi[a]);
 		}
-		if (bad) recordMoveFailures(P, grid, blocks[b], blocks[b + 1], err);
+		bad |= out | !(check - check == 0 && sp - sp == 0); // y − y ≠ 0: y is NaN or ±inf
+		far |= nf;
+		vm = std::max(vm, sp);
 	}
-	driftOut = drift;
-	return std::sqrt(v2max);
+	v2max = vm, drift |= far;
+	if (bad) recordMoveFailures(P, grid, p0, p1, err);
 }
 
 } // namespace mpm

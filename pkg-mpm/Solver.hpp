@@ -186,14 +186,13 @@ public:
 			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
 			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
-			ErrorRecord err;
-			const Real  rmin = updateStress(xfer, mat, dt, err);
-			throwIf(err, "stress update", true);
-			bool       drift = false;
-			const Real vm    = moveParticles(xfer, dt, err, drift);
-			throwIf(err, "position update", true);
-			vmax = vm, rhoMin = rmin;
-			if (drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
+			ErrorRecord errStress, errMove; // block by block: a block's particles move right after its stress update
+			const auto  st = updateStress(xfer, mat, dt, errStress, [&](uint32_t b, Real& v2max, int& drift) {
+				moveParticles(xfer, dt, b, v2max, drift, errMove); // while the block is in cache
+			});
+			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
+			vmax = std::sqrt(st.v2max), rhoMin = st.rhoMin;
+			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
 			t[5] = omp_get_wtime();
 		});
 		phase.sort += t[0] - t0, phase.p2g += t[1] - t[0], phase.grid += t[2] - t[1], phase.contact += t[3] - t[2];
