@@ -85,6 +85,21 @@ public:
 		work.emplace_back();
 		return int(groups.size()) - 1;
 	}
+	// Undo the registration of the last group and of its parts when they are the last parts and no other group
+	// uses them (a registration refused half-way, e.g. by captureInitialD0): the solver is as before it.
+	void removeLastGroup()
+	{
+		if (groups.empty()) throw InputError("there is no contact group to remove");
+		const auto& g     = groups.back();
+		const int   first = int(parts.size()) - int(g.parts.size());
+		for (size_t k = 0; k < g.parts.size(); ++k)
+			if (g.parts[k] != first + int(k)) throw InputError("the last contact group's parts are not the last rigid parts; it cannot be removed");
+		for (size_t gi = 0; gi + 1 < groups.size(); ++gi)
+			for (int p : groups[gi].parts)
+				if (p >= first) throw InputError("the last contact group's parts are shared with another group; it cannot be removed");
+		parts.resize(size_t(first));
+		groups.pop_back(), work.pop_back();
+	}
 	RigidGroup<D>& group(int g)
 	{
 		if (g < 0 || g >= int(groups.size())) throw InputError("contact group " + std::to_string(g) + " does not exist");
@@ -140,6 +155,37 @@ public:
 		g.topologyKnown = false;
 	}
 
+	// d0 = "initial" (ContactParams::initialD0): d0_p := d_p(0) for the first lattice layer of particles next to
+	// the group's surface at its current pose (the registration; bodies.py calls it right after adding the
+	// primitives and reading the poses), stored per stable particle id (sorting needs no plumbing; particles
+	// added later keep the default). First layer: d_p(0) < e_p max_i |n_i| with e_p = V_p^{1/D} and n the
+	// outward normal at the closest point — along a straight face exactly one particle of every lattice line
+	// along the dominant normal axis (those lines cross the face at a slope, consecutive particles of a line
+	// are e_p |n_i| apart in distance). It contains every particle within the default d0 = ½ e_p, since
+	// max_i |n_i| ≥ 1/√D > ½. A particle centre inside the body (d_p(0) < 0) is refused.
+	void captureInitialD0(int gi, const Particles<D>& P)
+	{
+		auto& g = group(gi);
+		if (!g.params.initialD0) throw InputError("contact group " + std::to_string(gi) + " was not created with d0 = 'initial'");
+		g.update(parts);
+		int64_t maxId = -1;
+		for (size_t p = 0; p < P.n; ++p) maxId = std::max(maxId, P.id[p]);
+		std::vector<Real> d0(size_t(maxId + 1), std::numeric_limits<Real>::quiet_NaN());
+		Real              dmax = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			Vec x;
+			for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+			const auto h = g.query(x);
+			const Real e = edgeOf(P.vol[p]);
+			if (!(h.d < e * h.n.cwiseAbs().maxCoeff())) continue; // not in the first layer
+			if (h.d < 0)
+				throw InputError("d0 = 'initial': particle id " + std::to_string(P.id[p]) + " lies inside the rigid body (signed distance "
+				                 + fmtNum(h.d) + " m); the body must not overlap the particles when it is registered");
+			d0[size_t(P.id[p])] = h.d, dmax = std::max(dmax, h.d);
+		}
+		g.d0Initial.swap(d0), g.d0InitialMax = dmax, g.d0Captured = true;
+	}
+
 	ContactNodes<D>     nodeArr; // per-node contact arrays (sized to the grid by the first step with bodies)
 	std::vector<size_t> marked; // nodes carrying the contact exclusion bit
 
@@ -160,8 +206,11 @@ public:
 				wk.skip = true;
 				continue;
 			}
+			if (g.params.initialD0 && !g.d0Captured)
+				throw InputError("contact group " + std::to_string(gi) + ": d0 = 'initial' needs captureInitialD0 at registration, before the first step");
 			g.update(parts);
-			const Real reach = (g.params.autoD0 ? 1.5 * l : g.params.d0 + l); // detection margin outside the surface
+			Real reach = (g.params.autoD0 ? 1.5 * l : g.params.d0 + l); // detection margin outside the surface
+			if (!g.d0Initial.empty()) reach = std::max(reach, g.d0InitialMax + l);
 			Vec        lo, hi;
 			// nodes covered by the body (within `band` of the surface)
 			g.bounds(0, band, lo, hi);
@@ -203,6 +252,8 @@ public:
 			}
 			// 1. normal penalty force of the contacted particles, Eq. 23
 			const Real chi = g.params.chi, twoOverDt2 = 2.0 / (dt * dt);
+			const Real*  d0i = g.d0Initial.empty() ? nullptr : g.d0Initial.data(); // d0 = "initial": per particle id
+			const size_t nd0i = g.d0Initial.size();
 			for (int c = 0; c < Dim<D>::nColours; ++c) {
 				IVec first, cnt;
 				size_t nb = 1;
@@ -223,7 +274,11 @@ public:
 					for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) {
 						Vec x;
 						for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
-						const Real d0 = g.params.autoD0 ? 0.5 * edgeOf(P.vol[p]) : g.params.d0;
+						Real d0 = g.params.autoD0 ? 0.5 * edgeOf(P.vol[p]) : g.params.d0;
+						if (d0i) {
+							const size_t id = size_t(P.id[p]);
+							if (id < nd0i && d0i[id] == d0i[id]) d0 = d0i[id]; // first layer at registration: d0_p = d_p(0)
+						}
 						if (d0 > wk.reach) continue; // beyond the detection margin (documented limit)
 						const auto h = g.query(x);
 						if (!(h.d - d0 < 0)) continue;

@@ -50,6 +50,13 @@ struct ContactParams {
 	Real chi      = 0.5;
 	Real d0       = 0;    // detection distance d0 [m], ≥ 0; used when autoD0 is false
 	bool autoD0   = true; // d0 = ½ V_p^{1/D}: half the particle's edge, i.e. contact when the particle's face touches
+	// d0 = "initial" (with autoD0): the paper's d0 is "the initial distance of particle used for the contact
+	// detection" (text after Eq. 26). The particles of the first lattice layer next to the surface when the
+	// group is registered get d0_p = d_p(0), their initial signed distance — a body filling a domain (a flaw
+	// filler) touches the material around it at zero force from t = 0; every other particle keeps ½ V_p^{1/D}.
+	// First layer: d_p(0) < e_p max_i |n_i| (e_p = V_p^{1/D}, n the outward normal at the closest point):
+	// one particle per lattice line along the dominant normal axis, for any face angle (PtsContact::captureInitialD0).
+	bool initialD0 = false;
 	void validate() const
 	{
 		requireRange(mu, 0, INFINITY, false, true, "contact friction coefficient mu", "[-]");
@@ -125,6 +132,11 @@ struct RigidGroup {
 	std::vector<int>         elemPart; // owning part of each element
 	std::vector<Vec>         elem;     // world vertices (updated)
 	bool                     closed = false; // the elements bound a volume (decided once, from the first pose)
+	// d0 = "initial" only (params.initialD0): d0 [m] per stable particle id, NaN = the default ½ V_p^{1/D};
+	// empty until captured (PtsContact::captureInitialD0). d0InitialMax: the largest captured value.
+	std::vector<Real>        d0Initial;
+	Real                     d0InitialMax = 0;
+	bool                     d0Captured   = false;
 	bool                     topologyKnown = false;
 
 	size_t nElements() const { return elemPart.size(); }

@@ -427,9 +427,26 @@ struct SolverWrap {
 		prm.mu       = argReal(mu, who("addContactGroup: mu"), "-");
 		prm.cohesion = argReal(cohesion, who("addContactGroup: cohesion"), "Pa");
 		prm.chi      = argReal(chi, who("addContactGroup: chi"), "-");
-		prm.autoD0   = d0.is_none();
+		bp::extract<std::string> word(d0);
+		if (word.check()) {
+			if (word() != "initial")
+				throw InputError(who("addContactGroup: d0") + " = '" + word() + "' must be a number >= 0 [m], None (half the particle edge) or 'initial'");
+			prm.initialD0 = true; // first layer: d0_p = initial distance (captureContactD0); the rest: half the particle edge
+		}
+		prm.autoD0 = d0.is_none() || prm.initialD0;
 		if (!prm.autoD0) prm.d0 = argReal(d0, who("addContactGroup: d0"), "m");
 		return s.contact.addGroup(prm, ps);
+	}
+	// d0 = 'initial': capture d0_p = d_p(0) of the first particle layer at the group's current pose (registration).
+	static void captureContactD0(S& s, int g) { s.contact.captureInitialD0(g, s.P); }
+	static void removeLastContactGroup(S& s) { s.contact.removeLastGroup(); }
+	// Captured d0 [m] per stable particle id (NaN: the default half edge); empty unless d0 = 'initial'.
+	static np::ndarray contactInitialD0(S& s, int g)
+	{
+		const auto& v   = s.contact.group(g).d0Initial;
+		np::ndarray out = np::empty(bp::make_tuple(v.size()), np::dtype::get_builtin<double>());
+		std::copy(v.begin(), v.end(), reinterpret_cast<double*>(out.get_data()));
+		return out;
 	}
 	static void addContactBox(S& s, int g, int part, bp::object centre, bp::object rot, bp::object half)
 	{
@@ -589,7 +606,14 @@ struct SolverWrap {
 		        .def("setNodeExcluded", &setNodeExcluded, (bp::arg("node"), bp::arg("excluded")))
 		        .def("addRigidPart", &addRigidPart, "new rigid part (one YADE body or clump); returns its index")
 		        .def("addContactGroup", &addContactGroup, (bp::arg("parts"), bp::arg("mu"), bp::arg("cohesion"), bp::arg("chi"), bp::arg("d0")),
-		             "contact group over rigid parts with μ [-], c [Pa], χ [-], d0 [m] (None = ½ particle edge); returns its index")
+		             "contact group over rigid parts with μ [-], c [Pa], χ [-], d0 [m] (None = ½ particle edge; 'initial' = the first "
+		             "particle layer's initial distance, see captureContactD0); returns its index")
+		        .def("captureContactD0", &captureContactD0, (bp::arg("group")),
+		             "d0 = 'initial': d0_p := initial distance of the first particle layer next to the group at its current pose")
+		        .def("removeLastContactGroup", &removeLastContactGroup,
+		             "undo the last addContactGroup and its rigid parts (a registration refused half-way)")
+		        .def("contactInitialD0", &contactInitialD0, (bp::arg("group")),
+		             "captured d0 [m] per particle id (NaN = default half edge); empty unless d0 = 'initial'")
 		        .def("addContactBox", &addContactBox, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("rotation"), bp::arg("half")))
 		        .def("addContactPlane", &addContactPlane, (bp::arg("group"), bp::arg("part"), bp::arg("point"), bp::arg("normal"), bp::arg("twoSided")))
 		        .def("addContactElement", &addContactElement, (bp::arg("group"), bp::arg("part"), bp::arg("vertices")))

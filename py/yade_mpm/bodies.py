@@ -34,6 +34,10 @@ Contact parameters (defaults and units; each validated with its range before any
   d0        detection distance d0 [m], ≥ 0; default None = ½ V_p^{1/D}, half the particle's own edge:
             a particle stands for a cell of edge V_p^{1/D} centred on it, so contact starts when that
             cell's face reaches the surface (for ppc = 2 this is a quarter of the grid spacing).
+            "initial": the paper's "initial distance of particle" — the particles of the first lattice
+            layer next to the body when ``add`` registers it get d0 = their initial distance to its surface
+            (they touch it at zero force from t = 0: a body filling a domain, e.g. a flaw filler); the
+            others keep ½ V_p^{1/D}. The body must not overlap any particle centre (ValueError).
 """
 import numpy as np
 
@@ -51,8 +55,9 @@ def _check_params(mu, cohesion, chi, d0, thickness):
                              ("chi", chi, lambda x: 0 <= x < 1, "[0, 1) [-]")):
         if not (isinstance(v, (int, float)) and np.isfinite(v) and ok(v)):
             bad(name, v, rng)
-    if d0 is not None and not (isinstance(d0, (int, float)) and np.isfinite(d0) and d0 >= 0):
-        bad("d0", d0, "[0, inf) [m] or None (half the particle edge)")
+    if not (d0 is None or (isinstance(d0, str) and d0 == "initial")
+            or (isinstance(d0, (int, float)) and not isinstance(d0, bool) and np.isfinite(d0) and d0 >= 0)):
+        bad("d0", d0, "[0, inf) [m], None (half the particle edge) or 'initial' (the first layer's initial distance)")
     if thickness is not None and not (isinstance(thickness, (int, float)) and np.isfinite(thickness) and thickness > 0):
         bad("thickness", thickness, "(0, inf) [m] or None (the body's z-extent)")
 
@@ -92,7 +97,8 @@ class RigidBodies:
             d0=CONTACT_DEFAULTS["d0"], thickness=None):
         """Register YADE bodies (an id or a list) as one contact group with friction coefficient mu [-],
         cohesion [Pa], residual penetration factor chi [-] and detection distance d0 [m] (None: half the
-        particle edge); thickness [m] overrides the 2D z-extent. Returns the group index."""
+        particle edge; "initial": the first particle layer's distance to the body now, see the module
+        docstring); thickness [m] overrides the 2D z-extent. Returns the group index."""
         _check_params(mu, cohesion, chi, d0, thickness)
         ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
         if not ids:
@@ -106,15 +112,30 @@ class RigidBodies:
         prims = [self._primitives(b) for b in bodies]   # validates shapes before touching the solver
         s = self.solver
         parts = [s.addRigidPart() for _ in bodies]
-        g = s.addContactGroup(parts, float(mu), float(cohesion), float(chi), None if d0 is None else float(d0))
+        g = s.addContactGroup(parts, float(mu), float(cohesion), float(chi), d0 if d0 is None or isinstance(d0, str) else float(d0))
         for b, part, (plist, t) in zip(bodies, parts, prims):
             for kind, args in plist:
                 getattr(s, kind)(g, part, *args)
+        if d0 == "initial":                # the first layer's distances at the bodies' poses now
+            try:
+                self._read_parts(zip((b.id for b in bodies), parts))
+                s.captureContactD0(g)
+            except ValueError:
+                s.removeLastContactGroup()   # refused (a particle inside the body): nothing registered
+                raise
+        for b, part, (plist, t) in zip(bodies, parts, prims):
             self._part_of[b.id] = len(self._parts)
             self._parts.append((b.id, part, thickness if thickness is not None else t))
         self.groups.append(g)
         self.read()
         return g
+
+    def initial_d0(self, group):
+        """d0 = "initial" groups: the captured d0 [m] per particle id (the ``"id"`` field), NaN where the
+        particle keeps the default ½ V_p^{1/D}; an empty array for other groups."""
+        if group not in self.groups:
+            raise ValueError(f"group = {group!r} is not a contact group of these bodies; groups: {self.groups}")
+        return np.asarray(self.solver.contactInitialD0(group))
 
     def _primitives(self, b):
         """[(solver method, args)], thickness for one body (a clump: its members in the clump frame)."""
@@ -184,9 +205,12 @@ class RigidBodies:
     # ------------------------------------------------------------------ every step
     def read(self):
         """Kinematics of every registered body from O.bodies into the solver (before the MPM step)."""
+        self._read_parts((bid, part) for bid, part, _ in self._parts)
+
+    def _read_parts(self, pairs):
         from yade import O
         d, s = self.dim, self.solver
-        for bid, part, _ in self._parts:
+        for bid, part in pairs:
             st = O.bodies[bid].state
             R, x, v, w = _rot(st.ori), st.pos, st.vel, st.angVel
             if d == 2:

@@ -154,6 +154,7 @@ PLATEN_SPEED = 0.1                 # downward velocity of the rigid top platen [
 TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displacement)
 PLATEN_FRICTION = 0.0              # platen–rock μ_con [-]: the paper's free-slip top
 FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
+FILLER_CHI = 0.5                   # filler–rock residual penetration factor χ [-] (doc/tunnel.md, doc/contact.md)
 TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
 TUNNEL_MAX_SPACING = 1.25 * FLAW_WIDTH   # coarsest grid [m]: the flaw still cuts a full row of particles (ppc = 2)
 
@@ -203,7 +204,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     O.reset()
     rb = RigidBodies(s)
     platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction)
-    filler = yade_filler(rb, flaw, ppc, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
+    filler = yade_filler(rb, flaw, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
     eng = yade_engines(s, rb, label)
     return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W)
 
@@ -227,21 +228,23 @@ def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0
     return pid
 
 
-def yade_filler(rb, flaw, ppc, friction, cohesion=0.0, density=None, blocked="zXY"):
-    """A free rigid YADE Box filling the flaw (dict of ``tunnel_flaw``) cut from the particles of
-    rb.solver (``_filler_half_sizes``), free in the plane (blockedDOFs `blocked`, default 'zXY'; 'zXYZ'
-    also blocks its rotation), registered with μ = friction [-], c = cohesion [Pa]; density [kg/m³] (None:
-    YADE's default 1000). Returns its YADE id."""
+def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None):
+    """A free rigid YADE Box that is the flaw (dict of ``tunnel_flaw``): the domain of the filling, its
+    length × width, registered in `rb` with d0 = "initial" (doc/contact.md) so the particles next to it —
+    the flaw is cut from the particle lattice, its faces are jagged — touch it at zero force from t = 0;
+    free in the plane (blockedDOFs `blocked`, default 'zXY'; 'zXYZ' also blocks its rotation); μ = friction
+    [-], c = cohesion [Pa], χ = chi [-] (None: FILLER_CHI); density [kg/m³] (None: YADE's default 1000).
+    The grid nodes it covers get the contact exclusion bit, as an open flaw's nodes get the user bit.
+    Returns its YADE id."""
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3
     from yade.wrapper import FrictMat
-    hl, hw = _filler_half_sizes(rb.solver, flaw, ppc)
     ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
     kw = {} if density is None else dict(material=FrictMat(density=density))
-    fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (hl, hw, BODY_HALF_THICKNESS),
+    fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (0.5 * flaw["length"], 0.5 * flaw["width"], BODY_HALF_THICKNESS),
                                     orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, **kw))
     O.bodies[fid].state.blockedDOFs = blocked      # default in the plane: x, y, rotation about z
-    rb.add(fid, mu=friction, cohesion=cohesion)
+    rb.add(fid, mu=friction, cohesion=cohesion, chi=FILLER_CHI if chi is None else chi, d0="initial")
     return fid
 
 
@@ -255,22 +258,6 @@ def yade_engines(solver, rb, label):
     O.engines = [ForceResetter(), eng.runner(), NewtonIntegrator(damping=0.0, gravity=(0, 0, 0))]
     O.dt = 1.0
     return eng
-
-
-def _filler_half_sizes(solver, flaw, ppc):
-    """Half length and half width [m] of a rigid filler that fills the flaw cut from the particle lattice
-    without overlapping any particle's cell (the PTS detection distance d0 is half the particle edge):
-    the cut is jagged on the lattice, so the box is the flaw shrunk to the nearest particle cell faces."""
-    x = get(solver, "pos") - flaw["center"]
-    d0 = 0.5 * solver.spacing / ppc
-    along, across = x @ flaw["direction"], x @ flaw["normal"]
-    band = np.abs(along) < 0.5 * flaw["length"]
-    hw = min(0.5 * flaw["width"], np.min(np.abs(across[band])) - d0)
-    side = np.abs(across) < hw + d0
-    hl = min(0.5 * flaw["length"], np.min(np.abs(along[side])) - d0)
-    if not (hw > 0 and hl > 0):
-        raise ValueError("the flaw holds no room for a filler at this grid spacing")
-    return hl, hw
 
 
 def tunnel_location(point, flaw=None):
@@ -402,7 +389,7 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H)
     rb = RigidBodies(s)
     platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction)
-    filler = yade_filler(rb, flaw, ppc, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
+    filler = yade_filler(rb, flaw, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
 

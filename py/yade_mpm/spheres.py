@@ -63,6 +63,9 @@ class DemSpheres:
         None (2D: the body's z-extent); max_check_steps: longest interval between broad-phase checks."""
         from yade import O
         _check_params(mu, cohesion, chi, d0, thickness)
+        if isinstance(d0, str):
+            raise ValueError(f"d0 = {d0!r}: DemSpheres takes a number >= 0 [m] or None (half the particle edge); "
+                             "'initial' is for RigidBodies (a body filling a domain at registration)")
         if int(max_check_steps) != max_check_steps or max_check_steps < 1:
             raise ValueError(f"max_check_steps = {max_check_steps!r} must be an integer ≥ 1")
         self.solver, self.dim = solver, dim_of(solver)
