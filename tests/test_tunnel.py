@@ -21,15 +21,22 @@ def test_flaw_cut_filler_and_grout():
     f, dp = b["flaw"], L / 2
     assert (n_int - s.numParticles) * dp ** 2 == pytest.approx(f["length"] * f["width"], rel=0.2)
     assert np.allclose(f["toe"], (0.045, 0.08)) and f["angle"] == pytest.approx(math.radians(60))
-    # the filler: inside the flaw, and no particle's cell (half-edge d0 = dp/2 around it) overlaps it
+    # the filler is the flaw (the domain of the filling), over no particle centre; registered with
+    # d0 = "initial": the particles within one lattice layer of it touch it at their initial distance
     from yade import O
     box = O.bodies[b["filler"]]
     hl, hw = box.shape.extents[0], box.shape.extents[1]
-    assert 0.9 * f["length"] / 2 < hl <= f["length"] / 2 and 0 < hw <= f["width"] / 2
+    assert hl == pytest.approx(f["length"] / 2, abs=1e-15) and hw == pytest.approx(f["width"] / 2, abs=1e-15)
     r = ym.get(s, "pos") - f["center"]
     along, across = np.abs(r @ f["direction"]), np.abs(r @ f["normal"])
     gap = np.hypot(np.maximum(along - hl, 0), np.maximum(across - hw, 0))
-    assert gap.min() >= dp / 2 - 1e-12
+    assert gap.min() >= 0 and np.all((along > hl) | (across > hw))
+    d0 = b["rigid"].initial_d0(b["rigid"].groups[-1])
+    face = (along < hl - dp) & (gap < dp * np.abs(f["normal"]).max())      # first layer along the long faces
+    assert face.sum() > 2 * 0.9 * f["length"] * np.abs(f["normal"]).max() / dp
+    np.testing.assert_allclose(d0[face], gap[face], atol=1e-12)
+    O.step()
+    assert np.all(b["rigid"].force(b["filler"]) == 0)   # in contact everywhere, at zero force
     assert b["filler"] in b["rigid"].ids and b["platen"] in b["rigid"].ids
     s_g, b_g = cases.arch_tunnel("grout_flaw", L)
     assert s_g.numParticles == n_int                 # the grout fills the cut exactly
