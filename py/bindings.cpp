@@ -140,8 +140,8 @@ struct SolverWrap {
 		np::ndarray m = asDoubleArray(mass, "masses", 0, n);
 		s.addParticles(reinterpret_cast<double*>(x.get_data()), reinterpret_cast<double*>(v.get_data()), reinterpret_cast<double*>(m.get_data()), n, mat);
 	}
-	// A 1-D array of particle slots (storage order), each ≥ 0; the callee checks the upper bound.
-	static std::vector<size_t> slotsArg(bp::object idx, const char* what)
+	// A 1-D array of particle slots (storage order), each in [0, n), checked before the caller changes anything.
+	static std::vector<size_t> slotsArg(bp::object idx, const char* what, size_t n)
 	{
 		bp::object  raw  = bp::import("numpy").attr("asarray")(idx);
 		std::string kind = bp::extract<std::string>(raw.attr("dtype").attr("kind"));
@@ -153,15 +153,18 @@ struct SolverWrap {
 		std::vector<size_t> slots(size_t(i.shape(0)));
 		for (size_t k = 0; k < slots.size(); ++k) {
 			if (ip[k] < 0) throw InputError("particle index " + std::to_string(ip[k]) + " is negative");
+			if (size_t(ip[k]) >= n)
+				throw InputError(who(what) + ": particle index " + std::to_string(ip[k]) + " is outside the allowed range [0, " + std::to_string(n) + ")");
 			slots[k] = size_t(ip[k]);
 		}
 		return slots;
 	}
 	static void setForces(S& s, bp::object idx, bp::object forces)
 	{
-		const auto  slots = slotsArg(idx, "setParticleForces: indices");
+		const auto  slots = slotsArg(idx, "setParticleForces: indices", s.P.n);
 		np::ndarray f     = asDoubleArray(forces, "forces", D, slots.size());
 		auto*       fp    = reinterpret_cast<double*>(f.get_data());
+		for (size_t k = 0; k < slots.size() * D; ++k) requireFinite(fp[k], "particle surface force"); // all or nothing
 		for (size_t k = 0; k < slots.size(); ++k) {
 			typename Dim<D>::Vec fv;
 			for (int a = 0; a < D; ++a) fv[a] = fp[k * D + a];
@@ -170,7 +173,7 @@ struct SolverWrap {
 	}
 	static void setParticleMaterial(S& s, bp::object idx, bp::object material)
 	{
-		const auto slots = slotsArg(idx, "setParticleMaterial: indices");
+		const auto slots = slotsArg(idx, "setParticleMaterial: indices", s.P.n);
 		s.setParticleMaterial(slots, argInt(material, who("setParticleMaterial: material"), 0, 255));
 	}
 	static void addPlane(S& s, bp::object axisO, bp::object sideO, bp::object posO, bp::object kindO)

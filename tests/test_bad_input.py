@@ -292,6 +292,20 @@ def test_damage_threshold_outside_unit_interval_refused():
     assert s2.numParticles == 0
 
 
+def test_set_particle_forces_is_all_or_nothing():
+    """A bad index or a NaN force later in the list used to be refused only after the forces before it
+    had been applied (a half-applied load)."""
+    s = _solver()
+    ym.add_region(s, ym.rocks.granite(), (0, 0), (1, 1))
+    s.setParticleForces([0], [[1.0, 2.0]])
+    n = s.numParticles
+    for idx, f, msg in (([0, n + 5], [[3.0, 4.0], [5.0, 6.0]], rf"particle index {n + 5} is outside the allowed range \[0, {n}\)"),
+                        ([0, 1], [[3.0, 4.0], [np.nan, 6.0]], "particle surface force must be a finite number")):
+        with pytest.raises(ValueError, match=msg):
+            s.setParticleForces(idx, f)
+        assert (s.view("trac0")[0], s.view("trac1")[0]) == (1.0, 2.0)
+
+
 @pytest.mark.parametrize("call, msg", [
     (lambda: _solver().setParticleForces(np.zeros(1), [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
     (lambda: _solver().setParticleForces(10 ** 20, [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
