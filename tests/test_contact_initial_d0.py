@@ -13,44 +13,48 @@ import yade_mpm as ym
 ELASTIC = dict(young=1e9, poisson=0.25, density=1000.0)
 
 
-def _lattice_with_box(theta, l=0.02, half=(0.3, 0.05), centre=(0.5, 0.5)):
-    """Particles on the square lattice (ppc 2, edge dp = l/2) filling [0, 1]² except the centres inside a
-    box of half extents `half` rotated by theta; the box registered as a contact group with d0 = "initial".
+def _lattice_with_box(theta, d=2):
+    """Particles on the square/cubic lattice (ppc 2, edge dp = l/2) filling [0, L]^d except the centres
+    inside a box rotated by theta about z; the box registered as a contact group with d0 = "initial".
     Returns (solver, group, particle positions sorted by id, box centre, rotation, half extents, dp)."""
-    s = ym.make_solver((0, 0), (1, 1), l)
+    L, l, half = (1.0, 0.02, (0.3, 0.05)) if d == 2 else (0.4, 0.04, (0.12, 0.02, 1.0))
+    s = ym.make_solver(np.zeros(d), np.full(d, L), l)
     dp = l / 2
-    ax = np.arange(dp / 2, 1, dp)
-    x = np.column_stack([a.ravel() for a in np.meshgrid(ax, ax, indexing="ij")])
-    R = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
-    q = (x - centre) @ R                                  # box frame
-    x = x[~np.all(np.abs(q) <= half, axis=1)]
+    ax = np.arange(dp / 2, L, dp)
+    x = np.column_stack([a.ravel() for a in np.meshgrid(*[ax] * d, indexing="ij")])
+    R = np.eye(d)
+    R[:2, :2] = [[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]]
+    centre, half = np.full(d, L / 2), np.asarray(half)
+    x = x[~np.all(np.abs((x - centre) @ R) <= half, axis=1)]   # centres inside the box (its frame) removed
     s.setMaterial(ym.ElasticMat(**ELASTIC))
-    s.addParticles(x, np.full(len(x), dp * dp), np.full(len(x), dp * dp * ELASTIC["density"]))
+    s.addParticles(x, np.full(len(x), dp ** d), np.full(len(x), dp ** d * ELASTIC["density"]))
     p = s.addRigidPart()
     g = s.addContactGroup([p], 0.0, 0.0, 0.5, "initial")
-    s.addContactBox(g, p, (0, 0), np.eye(2), half)
-    s.setRigidPartState(p, centre, R, (0, 0), 0.0)
+    s.addContactBox(g, p, np.zeros(d), np.eye(d), half)
+    s.setRigidPartState(p, centre, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     s.captureContactD0(g)
-    return s, g, ym.get(s, "pos"), np.asarray(centre), R, np.asarray(half), dp
+    return s, g, ym.get(s, "pos"), centre, R, half, dp
 
 
-@pytest.mark.parametrize("deg", [30.0, 60.0])
-def test_first_layer_is_one_particle_per_lattice_line_along_an_inclined_face(deg):
-    """Along the upper long face of a box inclined by 30° / 60°: the normal n = (−sin θ, cos θ); the
-    lattice lines along the dominant axis of n (columns for 30°, rows for 60°) each cross the face once,
-    and the particles of a line are dp·max|n_i| apart in distance, so exactly the nearest one outside the
-    face is the first layer. Counted independently from the lattice; its d0 is its distance."""
+@pytest.mark.parametrize("deg,d", [(30.0, 2), (60.0, 2), (30.0, 3)])
+def test_first_layer_is_one_particle_per_lattice_line_along_an_inclined_face(deg, d):
+    """Along the upper long face of a box inclined by 30° / 60° about z: the normal n = (−sin θ, cos θ, 0);
+    the lattice lines along the dominant axis of n (y for 30°, x for 60°) each cross the face once, and
+    the particles of a line are dp·max|n_i| apart in distance, so exactly the nearest one outside the face
+    is the first layer. Counted independently from the lattice (2D, and 3D with the box through the whole
+    depth); its d0 is its distance."""
     theta = math.radians(deg)
-    s, g, x, c, R, h, dp = _lattice_with_box(theta)
+    s, g, x, c, R, h, dp = _lattice_with_box(theta, d)
     d0 = s.contactInitialD0(g)
     assert len(d0) == len(x)
     sel = ~np.isnan(d0)
     n = R[:, 1]                                          # outward normal of the upper long face
     q = (x - c) @ R
-    dist = q[:, 1] - h[1]                                # distance to the face's line
-    interior = (np.abs(q[:, 0]) < h[0] - 3 * dp) & (dist > 0) & (dist < 3 * dp)   # away from the corners
-    axis = int(np.argmax(np.abs(n)))                     # 0: lines are rows (y const), 1: columns (x const)
-    line = np.round(x[:, 1 - axis] / dp - 0.5).astype(int)
+    dist = q[:, 1] - h[1]                                # distance to the face's plane
+    interior = (np.abs(q[:, 0]) < h[0] - 3 * dp) & (dist > 0) & (dist < 3 * dp)   # away from the edges
+    axis = int(np.argmax(np.abs(n)))                     # the lines run along this axis
+    _, line = np.unique(np.round(np.delete(x, axis, axis=1) / dp - 0.5).astype(int), axis=0, return_inverse=True)
+    line = line.ravel()
     expected = set()
     for k in np.unique(line[interior]):
         on = np.nonzero((line == k) & (dist > 0))[0]
@@ -59,12 +63,12 @@ def test_first_layer_is_one_particle_per_lattice_line_along_an_inclined_face(deg
             expected.add(int(first))
     picked = set(np.nonzero(sel & interior)[0].tolist())
     assert picked == expected
-    span = 2 * (h[0] - 3 * dp) * abs(n[axis]) / dp       # lines crossing that stretch of the face
-    assert abs(len(expected) - span) <= 2
+    depth = 1 if d == 2 else round(0.4 / dp)             # lines across the depth (3D: the box spans it)
+    span = 2 * (h[0] - 3 * dp) * abs(n[axis]) / dp       # lines crossing that stretch of the face, per depth
+    assert abs(len(expected) / depth - span) <= 2
     np.testing.assert_allclose(d0[sorted(expected)], dist[sorted(expected)], atol=1e-12)
     assert np.all(dist[sorted(expected)] < dp * np.abs(n).max())
-    # the second particle of each line is not picked
-    assert not np.any(sel & interior & (dist >= dp * np.abs(n).max()))
+    assert not np.any(sel & interior & (dist >= dp * np.abs(n).max()))   # the second particle of a line: never
 
 
 def _slab_on_block(d0, gap, l=0.02, chi=0.5):
