@@ -29,7 +29,8 @@ thickness t (default: its z-extent, 2R for a sphere at z = 0; or ``thickness``),
 ``bodies.py``: a sphere of YADE mass m moves like a disc of m/t per metre. 2D spheres must stay in the
 plane (``blockedDOFs = 'zXY'``); the trace is taken at registration.
 
-Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation).
+Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation; d0 = "initial",
+for a body filling a domain at registration, is refused here).
 """
 import functools
 import math
