@@ -198,6 +198,9 @@ def uniaxial(R):
     s = R.load("uniaxial_flaw")
     if s is None:
         return
+    notes = os.path.join(R.folder("uniaxial_flaw"), "notes.md")   # how the runs were made
+    if os.path.exists(notes):
+        R.w(open(notes).read().rstrip(), "")
     flat = {k: v for k, v in s.items() if isinstance(v, (int, float, str, bool))}
     if flat:
         R.w(*table([{"k": k, "v": v} for k, v in flat.items()], [("quantity", lambda r: r["k"]), ("value", lambda r: r["v"])]))
