@@ -9,7 +9,9 @@ Cases: the benchmark scenes of scripts/bench.py (run through that build's own be
 scene and steps: elastic2d_80k, dpgk2d_80k, …), and `free_elastic` / `free_dpgk`, the same 200 × 100-cell
 block with no boundary plane at all (no one-sided fits, no mirror folds) and the DP–GK parameters of the
 benchmark with V = particle volume in Eq. 37, built with calls every build since issue 4 has — so that
-an old and a new build run the same code paths and physics.
+an old and a new build run the same code paths and physics; `tunnel_paper` / `tunnel_2mm`, the paper's arch
+tunnel (cases.arch_tunnel "intact", 1 mm / 2 mm grid) stepped through YADE with its rigid platen, as
+scripts/tunnel_spalling.py runs it (builds with cases.arch_tunnel only).
 
     git -C . worktree add /tmp/wt-before before-session        # build it there: cmake … && cmake --build …
     flock /work/bench.lock /usr/bin/python3 scripts/bench_ab.py --out out/ab \\
@@ -56,12 +58,34 @@ print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.nu
 '''
 FREE_STEPS = (250, 20)
 
+# The paper's tunnel (Sec. 4) as scripts/tunnel_spalling.py runs it: cases.arch_tunnel in YADE (rigid platen in PTS
+# contact, MpmEngine, O.step), timed over a few hundred steps from the start (little damage yet).
+TUNNEL_CHILD = r'''
+import json, time, yade_mpm as ym
+from yade_mpm import cases
+from yade import O
+s, b = cases.arch_tunnel("intact", SPACING)
+for _ in range(WARMUP):
+    O.step()
+s.resetPhaseTimes()
+c0, t0 = time.process_time(), time.perf_counter()
+for _ in range(STEPS):
+    O.step()
+wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.numParticles, phases=s.phaseTimes())))
+'''
+TUNNEL_CASES = {"tunnel_paper": (0.001, 200, 20), "tunnel_2mm": (0.002, 400, 20)}   # spacing [m], timed and warm-up steps
+
 
 def run_one(case, build, threads):
     """One timed run of `case` with build (name, pydir, benchpy) and `threads` OpenMP threads."""
     _, pydir, benchpy = build
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false", PYTHONPATH=pydir)
-    if case.startswith("free_"):
+    if case in TUNNEL_CASES:
+        sp, steps, warm = TUNNEL_CASES[case]
+        code = TUNNEL_CHILD.replace("SPACING", repr(sp)).replace("WARMUP", str(warm)).replace("STEPS", str(steps))
+        cmd = [sys.executable, "-c", code]
+    elif case.startswith("free_"):
         sys.path.insert(0, os.path.join(os.path.dirname(HERE), "py"))
         from yade_mpm import rocks                                # the parameter sets, written once
         rock = dict(elastic=rocks.GRANITE, dpgk=rocks.GRANITE_DPGK)[case[5:]]
