@@ -13,6 +13,7 @@
 //     2. node pass: relative velocity with the rigid body at the node, ṽ_i = v_i − (v + ω × (x_i − c))
 //        (Eq. 26), tangential part (Eq. 25), stick force f_stick = −m_i ṽ_tan/Δt, Coulomb limit
 //        μ N_i + A_i c (Eq. 24): stick below, slip at the limit; v_i += Δt (f_nor + f_tan)/m_i;
+//        for a free body ṽ_tan is taken against the body's motion after the step (bodyResponse, below);
 //     3. reaction: the part owning the surface point nearest each node receives −(f_nor + f_tan) and
 //        its moment about the part's centre, summed in node order (exactly the opposite of what the
 //        grid received).
@@ -27,9 +28,31 @@
 // defined above sums to l (2D) / l² (3D) per node column of a flat surface, i.e. the paper's value,
 // and Σ_i A_i is the contact area whatever the offset.
 //
+// Stick step of a free body (step 2; Eq. 24 with the body's mass). f_stick = −m_i ṽ_tan/Δt stops the node
+// relative to a body that does not move. A free body receives −Σ_j f_j from its contact nodes j (f_nor,j ≠ 0):
+// for a uniform slip ṽ and mass M its velocity changes by S ṽ/M (S = Σ_j m_j), so a body lighter than its
+// contact nodes overshoots every step (the tunnel's flaw filler, 0.28 kg/m against ~0.8 kg/m of nodes,
+// reversed its slip 199 times in 200 steps). Instead every node sticks to the body's motion after the step,
+// q + Δq (q = (v, ω); the body's velocity at x_j is J_j q = v + ω × r_j, r_j = x_j − c; P_j = 1 − n_j n_jᵀ):
+//     f_stick,j = −m_j P_j (ṽ_j − J_j Δq)/Δt,
+// where Δq is what the reactions −Σ_j f_j do to the body, (M, I) Δq = Σ_j m_j J_jᵀ P_j (ṽ_j − J_j Δq), i.e.
+//     (1 + W A) Δq = W b,   A = Σ_j m_j J_jᵀ P_j J_j,   b = Σ_j m_j J_jᵀ ṽ_tan,j,   W = diag(1/M, I⁻¹)
+// (D + 1 unknowns in 2D, 6 in 3D; W = 0 along a prescribed motion, whose Δq is then 0). Every tangential slip
+// is gone after the step, momentum and angular momentum of body + nodes conserved — an inelastic stick of the
+// nodes to the rigid body, for any slip pattern: a uniform slip along a face with the rotation prescribed
+// gives the reduced mass, f_stick = −m_j ṽ_tan M/(M + S)/Δt; the opposite slips of two faces shearing a
+// flaw filler give b = 0, Δq = 0, the full stick. (A single factor α on −m_j ṽ_tan/Δt, α = M/(M + S) or
+// 1/(1 + S/M + R) with the rotational compliance R, stops one mode but only a fraction α of the two faces'
+// opposite slip: at true mass the tunnel filler then carried no friction, its curve that of μ = 0.)
+// The Coulomb limit of Eq. 24 applies unchanged to this f_stick. Sums per part over the group's contact
+// nodes, weighted with the node's share in the reaction (symmetry planes), by one thread in node order; an
+// immovable part (M = I = inf: a prescribed body) keeps exactly the paper's step and its groups the parallel
+// node pass.
+//
 // Parallel and deterministic: the particle pass is a block-coloured scatter restricted to the blocks
 // near the group (same-colour blocks never share a node, each block summed by one thread in particle
-// order); the node pass is independent per node; the reaction is summed by one thread in node order.
+// order); the node pass is independent per node (one thread in node order for a group with a free part,
+// after its sums); the reaction is summed by one thread in node order.
 // Results are bitwise identical for any thread count. A solver without groups never calls any of it.
 #pragma once
 #include "BlockSchedule.hpp"
@@ -76,6 +99,7 @@ public:
 	{
 		ensureArrays(grid);
 		work.resize(groups.size()); // per-group scratch, one per registered group
+		dq.resize(parts.size()), Aq.resize(parts.size()), bq.resize(parts.size()); // per-part scratch of bodyResponse
 		for (size_t i : marked) grid.setContactExcluded(i, false);
 		marked.clear();
 		for (auto& q : parts) q.force.setZero(), q.torque.setZero();
@@ -88,6 +112,8 @@ public:
 				wk.skip = true;
 				continue;
 			}
+			wk.movable = false;
+			for (int p : g.parts) wk.movable = wk.movable || parts[p].movable();
 			if (g.params.initialD0 && !g.d0Captured)
 				throw InputError("contact group " + std::to_string(gi) + ": d0 = 'initial' needs captureInitialD0 at registration, before the first step");
 			g.update(parts);
@@ -196,14 +222,13 @@ public:
 			// 2. stick / slip per node, Eqs. 24–26
 			const Real mu = g.params.mu, coh = g.params.cohesion;
 			const bool onePart = g.parts.size() == 1;
-#pragma omp for schedule(static)
-			for (size_t j = 0; j < nn; ++j) {
+			auto       stickSlip = [&](size_t j, const Motion* resp) {
 				const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
 				Vec          fn;
 				for (int a = 0; a < D; ++a) fn[a] = A.fn[a][i];
 				const Real fnorm = fn.norm();
 				auto&      nd    = grid.nodes[i];
-				if (fnorm == 0 || !(nd.m > massFloor)) continue;
+				if (fnorm == 0 || !(nd.m > massFloor)) return;
 				const Vec xi = grid.position(i);
 				const int pi = onePart ? g.parts[0] : g.query(xi).part;
 				const Vec nrm = fn / fnorm;
@@ -211,6 +236,7 @@ public:
 				for (int a = 0; a < D; ++a) v[a] = nd.a[a];
 				Vec rel = v + (dt / nd.m) * fn - parts[pi].velocityAt(xi); // Eq. 26
 				Vec vt  = rel - rel.dot(nrm) * nrm;                        // Eq. 25
+				if (resp) vt -= tangential(resp[pi].at(xi - parts[pi].c), nrm); // against the body's motion after the step
 				Vec ft  = (-nd.m / dt) * vt;                               // f_stick
 				const Real fmax = mu * A.load[i] + A.area[i] * coh; // Coulomb limit of Eq. 24
 				const Real fs   = ft.norm();
@@ -220,6 +246,16 @@ public:
 				for (int a = 0; a < D; ++a) {
 					nd.a[a]     = (fix >> a) & 1 ? 0.0 : v[a] + dt * f[a] / nd.m;
 					A.force[a][i]  = f[a];
+				}
+			};
+			if (!wk.movable) {
+#pragma omp for schedule(static)
+				for (size_t j = 0; j < nn; ++j) stickSlip(j, nullptr);
+			} else {
+#pragma omp single
+				{
+					bodyResponse(grid, g, wk, dt, massFloor);
+					for (size_t j = 0; j < nn; ++j) stickSlip(j, dq.data());
 				}
 			}
 			// 3. reaction on the parts: minus the nodal contact forces, in node order
@@ -243,11 +279,105 @@ public:
 private:
 	struct Work {
 		bool skip = true;
+		bool movable = false; // a part of the group is free (finite mass or inertia): stick step with α < 1
 		IVec blo, bhi; // block coordinate range of the particle pass
 		IVec nlo, nhi; // stored node coordinate range of the node pass
 		Real reach = 0;
 	};
 	std::vector<Work> work;
+	static constexpr int NS = D == 2 ? 1 : 3, NQ = D + NS; // rotations, rigid-body unknowns (v, ω)
+	using QVec = Eigen::Matrix<Real, NQ, 1>;
+	using QMat = Eigen::Matrix<Real, NQ, NQ>;
+	struct Motion { // the body's velocity change of the step, Δq = (Δv, Δω)
+		Vec       v = Vec::Zero();
+		SpinOf<D> w = SpinOf<D>::Zero();
+		Vec       at(const Vec& r) const { return v + crossSpin<D>(w, r); }
+	};
+	std::vector<Motion> dq; // per part, set by bodyResponse
+	static Vec tangential(const Vec& u, const Vec& n) { return u - u.dot(n) * n; }
+	// J_jᵀ u = (u, r × u): the generalised force of a force u at r on (v, ω).
+	static QVec jT(const Vec& r, const Vec& u)
+	{
+		QVec g;
+		g.template head<D>() = u;
+		g.template tail<NS>() = momentOf<D>(r, u);
+		return g;
+	}
+
+	// A contact node of a group as the body response sees it (Eqs. 25–26): its part, lever arm, normal,
+	// tangential relative velocity, mass, share in the body's reaction (symmetry planes) and Coulomb limit.
+	struct ContactNode {
+		int  part;
+		Vec  r, n, vt;
+		Real m, share, fmax;
+	};
+	bool contactNode(const Grid<D>& grid, const RigidGroup<D>& g, size_t i, Real dt, Real massFloor, ContactNode& c) const
+	{
+		const auto& A = nodeArr;
+		Vec         fn;
+		for (int a = 0; a < D; ++a) fn[a] = A.fn[a][i];
+		const Real  fnorm = fn.norm();
+		const auto& nd    = grid.nodes[i];
+		if (fnorm == 0 || !(nd.m > massFloor)) return false;
+		const Vec xi = grid.position(i);
+		c.part       = g.parts.size() == 1 ? g.parts[0] : g.query(xi).part;
+		const auto& q = parts[c.part];
+		Vec         v;
+		for (int a = 0; a < D; ++a) v[a] = nd.a[a];
+		c.n    = fn / fnorm, c.r = xi - q.c;
+		c.vt   = tangential(v + (dt / nd.m) * fn - q.velocityAt(xi), c.n); // Eqs. 25–26
+		c.m    = nd.m;
+		c.share = grid.hasMirrors() ? grid.mirrorShare(i) : 1;
+		c.fmax = g.params.mu * A.load[i] + A.area[i] * g.params.cohesion; // Coulomb limit of Eq. 24
+		return true;
+	}
+
+	// Δq of each free part of group g (see the header; Eq. 24 with a free body), serial, in node order:
+	// 1. A and b over all contact nodes, (1 + W A) Δq = W b (every node sticks);
+	// 2. the nodes whose f_stick against that Δq exceeds the Coulomb limit slip: their force, at the limit along
+	//    f_stick, is a known impulse c on the body; A and b over the others, (1 + W A) Δq = W (b + c).
+	// The node pass then sticks or slips each node against this Δq. An immovable part gets Δq = 0.
+	void bodyResponse(const Grid<D>& grid, const RigidGroup<D>& g, const Work& wk, Real dt, Real massFloor)
+	{
+		const size_t nn = boxCount(wk.nlo, wk.nhi);
+		for (int pass = 0; pass < 2; ++pass) {
+			for (int p : g.parts) Aq[p].setZero(), bq[p].setZero();
+			for (size_t j = 0; j < nn; ++j) {
+				ContactNode c;
+				if (!contactNode(grid, g, boxNode(grid, wk.nlo, wk.nhi, j), dt, massFloor, c)) continue;
+				if (pass == 1) { // slipping against the all-stick Δq: a known force at the limit
+					const Vec  ft = (-c.m / dt) * (c.vt - tangential(dq[c.part].at(c.r), c.n));
+					const Real fs = ft.norm();
+					if (fs >= c.fmax) {
+						bq[c.part] -= (c.share * dt) * jT(c.r, fs > 0 ? Vec(ft * (c.fmax / fs)) : Vec(Vec::Zero()));
+						continue;
+					}
+				}
+				const Real m = c.share * c.m;
+				bq[c.part] += m * jT(c.r, c.vt);
+				// J_jᵀ P_j J_j: column k of J_j is e_k (v) or e_k × r (ω)
+				QMat JtJ;
+				for (int k = 0; k < NQ; ++k) {
+					const Vec col = k < D ? Vec(Vec::Unit(k)) : crossSpin<D>(SpinOf<D>::Unit(k - D), c.r);
+					JtJ.col(k)    = jT(c.r, tangential(col, c.n));
+				}
+				Aq[c.part] += m * JtJ;
+			}
+			for (int p : g.parts) {
+				const auto& q = parts[p];
+				dq[p]         = Motion {};
+				if (!q.movable()) continue;
+				QMat W = QMat::Zero();
+				W.template topLeftCorner<D, D>().diagonal().setConstant(1 / q.mass);
+				W.template bottomRightCorner<NS, NS>() = q.inverseInertia();
+				const QVec x = (QMat::Identity() + W * Aq[p]).partialPivLu().solve(W * bq[p]);
+				dq[p].v      = x.template head<D>();
+				dq[p].w      = x.template tail<NS>();
+			}
+		}
+	}
+	std::vector<QMat> Aq; // per part: A of bodyResponse
+	std::vector<QVec> bq; // per part: b (+ c) of bodyResponse
 
 	void ensureArrays(const Grid<D>& grid)
 	{

@@ -76,7 +76,32 @@ struct RigidPart {
 	SpinOf<D>  w = SpinOf<D>::Zero();     // angular velocity [rad/s]
 	Vec        force  = Vec::Zero();      // reaction from the MPM grid in the last step [N] (2D: N per m)
 	SpinOf<D>  torque = SpinOf<D>::Zero(); // its moment about c [N m] (2D: N m per m)
+	// The body's inertia as the stick step of Eq. 24 sees it (PtsContact::bodyResponse: the body's motion after the step):
+	// mass [kg] (2D: kg per m of thickness), in (0, inf]; inf (default) = immovable along its translations
+	// (a prescribed body: blocked DOFs, not dynamic), which gives the paper's stick step unchanged.
+	Real       mass    = INFINITY;
+	// principal moments of inertia about c along the axes of R [kg m²] (2D: I_z only, kg m² per m), each in
+	// (0, inf]; inf (default) = that rotation prescribed.
+	SpinOf<D>  inertia = SpinOf<D>::Constant(INFINITY);
 	Vec velocityAt(const Vec& x) const { return v + crossSpin<D>(w, x - c); }
+	bool movable() const { return mass < INFINITY || (inertia.array() < INFINITY).any(); }
+
+	void setMass(Real m, const SpinOf<D>& I)
+	{
+		auto check = [](Real x, const char* name, const char* unit) {
+			if (!(x > 0)) throw InputError(std::string(name) + " = " + fmtNum(x) + " " + unit + " is outside the allowed range (0, inf]");
+		};
+		check(m, "rigid body mass", D == 2 ? "[kg/m]" : "[kg]");
+		for (int k = 0; k < I.size(); ++k) check(I[k], "rigid body moment of inertia", D == 2 ? "[kg m^2/m]" : "[kg m^2]");
+		mass = m, inertia = I;
+	}
+	// Inverse inertia tensor in the world frame, R diag(1/I) R^T (an infinite moment gives 0) [1/(kg m²)].
+	Eigen::Matrix<Real, D == 2 ? 1 : 3, D == 2 ? 1 : 3> inverseInertia() const
+	{
+		const SpinOf<D> inv = inertia.cwiseInverse();
+		if constexpr (D == 2) return inv;
+		else return R * inv.asDiagonal() * R.transpose();
+	}
 
 	void setState(const Vec& c_, const Mat& R_, const Vec& v_, const SpinOf<D>& w_)
 	{

@@ -473,6 +473,39 @@ struct SolverWrap {
 		s.contact.part(part).setState(toVec<D>(pos, "rigid body position"), toMat(rot, "rigid body orientation"), toVec<D>(vel, "rigid body velocity"),
 		                              toSpin(angVel, "rigid body angular velocity"));
 	}
+	// Mass [kg] / a moment of inertia [kg m²] of a rigid part (2D: per metre), in (0, inf]; inf = immovable along it.
+	static Real massArg(const bp::object& o, const std::string& name, const char* unit)
+	{
+		bp::extract<double> x(o);
+		if (!PyBool_Check(o.ptr()) && x.check() && std::isinf(x()) && x() > 0) return INFINITY;
+		return argReal(o, name + " (or inf: immovable)", unit, 0, INFINITY, OO);
+	}
+	static Spin inertiaArg(const bp::object& o, const std::string& name)
+	{
+		const char* unit = D == 2 ? "kg m^2/m" : "kg m^2";
+		Spin        I;
+		if constexpr (D == 2) I[0] = massArg(o, name + " (I_z)", unit);
+		else {
+			PyObject* q = o.ptr();
+			if (!(PySequence_Check(q) && !PyUnicode_Check(q) && PySequence_Size(q) == 3)) {
+				PyErr_Clear();
+				throw InputError(name + " must be a sequence of 3 principal moments [kg m^2] (got " + pyTypeName(q) + " " + pyRepr(o) + ")");
+			}
+			for (int a = 0; a < 3; ++a) I[a] = massArg(o[a], name + "[" + std::to_string(a) + "]", unit);
+		}
+		return I;
+	}
+	// Mass and principal moments of inertia (axes of the part's rotation) for the stick step's body share.
+	static void setRigidPartMass(S& s, int part, bp::object mass, bp::object inertia)
+	{
+		auto& q = s.contact.part(part);
+		q.setMass(massArg(mass, who("setRigidPartMass: mass"), D == 2 ? "kg/m" : "kg"), inertiaArg(inertia, who("setRigidPartMass: inertia")));
+	}
+	static bp::tuple rigidPartMass(S& s, int part)
+	{
+		const auto& q = s.contact.part(part);
+		return bp::make_tuple(q.mass, fromSpin(q.inertia));
+	}
 	static void addContactSphere(S& s, int g, int part, bp::object centre, double radius)
 	{
 		s.contact.addSphere(g, part, toVec<D>(centre, "sphere centre"), radius);
@@ -506,6 +539,23 @@ struct SolverWrap {
 			for (int a = 0; a < NS; ++a) om[a] = wp[k * NS + a];
 			q.setState(c, q.R, u, om);
 		}
+	}
+	// Masses (n,) and principal moments of inertia (n, 1 | 3) of parts, each in (0, inf] (inf: immovable along it).
+	static void setRigidPartMasses(S& s, bp::object parts, bp::object mass, bp::object inertia)
+	{
+		const auto  ps = intList(parts, "parts");
+		const size_t n = ps.size();
+		constexpr int NS = D == 2 ? 1 : 3;
+		np::ndarray m = asDoubleArray(mass, "masses", 0, n), I = asDoubleArray(inertia, "moments of inertia", NS, n);
+		auto *mp = reinterpret_cast<double*>(m.get_data()), *ip = reinterpret_cast<double*>(I.get_data());
+		for (int pass = 0; pass < 2; ++pass) // every entry checked before any is changed
+			for (size_t k = 0; k < n; ++k) {
+				Spin J;
+				for (int a = 0; a < NS; ++a) J[a] = ip[k * NS + a];
+				RigidPart<D> probe;                         // pass 0: validate on a copy
+				auto&        q = s.contact.part(ps[k]);     // checks the index
+				(pass ? q : probe).setMass(mp[k], J);
+			}
 	}
 	// Reaction forces (n, D) and torques (n, 1 | 3) of parts from the last step.
 	static bp::tuple rigidPartReactions(S& s, bp::object parts)
@@ -627,6 +677,13 @@ struct SolverWrap {
 		             "switch contact groups on/off (off: skipped entirely)")
 		        .def("setRigidPartMotions", &setRigidPartMotions, (bp::arg("parts"), bp::arg("pos"), bp::arg("vel"), bp::arg("angVel")),
 		             "positions, velocities, angular velocities of many parts (orientation unchanged)")
+		        .def("setRigidPartMass", &setRigidPartMass, (bp::arg("part"), bp::arg("mass"), bp::arg("inertia")),
+		             "mass [kg] (2D: kg/m) and principal moments of inertia about the centre along the part's axes [kg m^2] (2D: I_z, "
+		             "kg m^2/m) of a part, each in (0, inf]; inf (the default) = immovable along it (the paper's stick step). A free "
+		             "part's stick force is scaled by its share of the mass (doc/contact.md)")
+		        .def("rigidPartMass", &rigidPartMass, bp::arg("part"), "(mass, inertia) of a part as set by setRigidPartMass")
+		        .def("setRigidPartMasses", &setRigidPartMasses, (bp::arg("parts"), bp::arg("mass"), bp::arg("inertia")),
+		             "masses (n,) and principal moments of inertia (n, 1|3) of many parts, as setRigidPartMass")
 		        .def("rigidPartReactions", &rigidPartReactions, bp::arg("parts"), "(forces (n, D), torques (n, 1|3)) of parts")
 		        .def("rigidPartForce", &rigidPartForce, bp::arg("part"))
 		        .def("rigidPartTorque", &rigidPartTorque, bp::arg("part"))

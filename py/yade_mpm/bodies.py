@@ -10,6 +10,8 @@ Every step the engine calls ``read()`` (position, orientation, velocity and angu
 registered body from ``O.bodies`` into the solver) before the MPM step and ``write()`` (the contact
 reaction force and its torque about the body's centre, ``state.pos``, added to ``O.forces``) after it,
 so NewtonIntegrator moves free bodies and bodies with ``blockedDOFs`` and a set velocity keep it.
+``read()`` also passes each body's mass and inertia (``body_inertia``): the stick step of the friction
+(Eq. 24) moves a free body with its contact nodes, so a light body does not overshoot (doc/contact.md).
 
 Shapes: ``Box`` (oriented), ``Wall`` (``sense`` +1 / −1: the material is on the +axis / −axis side and
 the wall is a half-space; ``sense`` 0: a two-sided plane), ``Facet`` (a triangle; facets of one ``add``
@@ -71,6 +73,27 @@ def _yade_body(i):
     if b.isClumpMember:
         raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
     return b
+
+
+def body_inertia(b, dim, thickness):
+    """(mass, principal moments) of YADE body `b` as the contact's stick step sees it, inf along what is
+    prescribed: a body that is not dynamic, or with a translational DOF of the plane (2D: x, y; 3D: x, y, z)
+    in ``blockedDOFs``, has an infinite mass; a blocked rotation (2D: Z; 3D: any of X, Y, Z) infinite
+    moments. 2D: per metre of `thickness` [kg/m, kg m²/m], the z moment only (a float); 3D: [kg], the three
+    principal moments along the body's axes [kg m²] (a tuple)."""
+    st, inf = b.state, float("inf")
+    blocked, fixed = st.blockedDOFs, not b.dynamic
+    trans, rot = ("xy", "Z") if dim == 2 else ("xyz", "XYZ")
+    mass = inf if fixed or any(c in blocked for c in trans) else st.mass
+    free_rot = not (fixed or any(c in blocked for c in rot))
+    if mass != inf and not mass > 0:
+        raise ValueError(f"body id {b.id}: state.mass = {mass!r} kg must be > 0 for a dynamic body free in the plane")
+    moments = [st.inertia[a] if free_rot else inf for a in ((2,) if dim == 2 else (0, 1, 2))]
+    if free_rot and not all(m > 0 for m in moments):
+        raise ValueError(f"body id {b.id}: state.inertia = {tuple(st.inertia)!r} kg m² must be > 0 for a free rotation")
+    if dim == 2:
+        return mass / thickness, moments[0] / thickness
+    return mass, tuple(moments)
 
 
 def _rot(q):
@@ -204,8 +227,12 @@ class RigidBodies:
 
     # ------------------------------------------------------------------ every step
     def read(self):
-        """Kinematics of every registered body from O.bodies into the solver (before the MPM step)."""
+        """Kinematics, mass and inertia (``body_inertia``) of every registered body from O.bodies into the
+        solver (before the MPM step)."""
+        from yade import O
         self._read_parts((bid, part) for bid, part, _ in self._parts)
+        for bid, part, t in self._parts:
+            self.solver.setRigidPartMass(part, *body_inertia(O.bodies[bid], self.dim, t))
 
     def _read_parts(self, pairs):
         from yade import O

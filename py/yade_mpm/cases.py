@@ -155,14 +155,6 @@ TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displaceme
 PLATEN_FRICTION = 0.0              # platen–rock μ_con [-]: the paper's free-slip top
 FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
 FILLER_CHI = 0.5                   # filler–rock residual penetration factor χ [-] (doc/tunnel.md, doc/contact.md)
-# Mass scaling of the free rigid filler [-]: its YADE mass and inertia are this × those of its volume at the
-# given density. The explicit PTS coupling removes a node's relative tangential velocity in one step as if
-# the body were immovable (Eq. 24 stick); a free body lighter than the grid nodes along its faces
-# (the 60 × 2 mm filler at l = 2 mm: 0.28 kg/m against ~0.8 kg/m of nodes) then overshoots every step and
-# chatters (its velocity along the flaw flipped sign 199 times in 200 steps), so friction averages out.
-# At 10× it moves smoothly; under the 0.1 m/s platen its inertia force stays < 0.3 % of the face forces
-# (doc/tunnel.md).
-FILLER_MASS_SCALE = 10.0
 TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
 TUNNEL_MAX_SPACING = 1.25 * FLAW_WIDTH   # coarsest grid [m]: the flaw still cuts a full row of particles (ppc = 2)
 
@@ -236,17 +228,15 @@ def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0
     return pid
 
 
-def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None, mass_scale=None):
+def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None):
     """A free rigid YADE Box that is the flaw (dict of ``tunnel_flaw``): the domain of the filling, its
     length × width, registered in `rb` with d0 = "initial" (doc/contact.md) so the particles next to it —
     the flaw is cut from the particle lattice, its faces are jagged — touch it at zero force from t = 0;
     free in the plane (blockedDOFs `blocked`, default 'zXY'; 'zXYZ' also blocks its rotation); μ = friction
-    [-], c = cohesion [Pa], χ = chi [-] (None: FILLER_CHI); density [kg/m³] (None: YADE's default 1000);
-    mass and inertia × mass_scale (None: FILLER_MASS_SCALE, see there). The grid nodes it covers get the
-    contact exclusion bit, as an open flaw's nodes get the user bit. Returns its YADE id."""
-    k = FILLER_MASS_SCALE if mass_scale is None else mass_scale
-    if not (isinstance(k, (int, float)) and not isinstance(k, bool) and math.isfinite(k) and k >= 1):
-        raise ValueError(f"mass_scale = {k!r} must be a finite number >= 1 (the filler's mass and inertia factor)")
+    [-], c = cohesion [Pa], χ = chi [-] (None: FILLER_CHI); density [kg/m³] (None: YADE's default 1000):
+    its true mass, lighter than the grid nodes along its faces — the stick step moves it with its contact
+    nodes (doc/contact.md). The grid nodes it covers get the contact exclusion bit, as an open flaw's nodes
+    get the user bit. Returns its YADE id."""
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3
     from yade.wrapper import FrictMat
@@ -255,7 +245,6 @@ def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", c
     fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (0.5 * flaw["length"], 0.5 * flaw["width"], BODY_HALF_THICKNESS),
                                     orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, **kw))
     st = O.bodies[fid].state
-    st.mass, st.inertia = k * st.mass, k * st.inertia
     st.blockedDOFs = blocked                       # default in the plane: x, y, rotation about z
     rb.add(fid, mu=friction, cohesion=cohesion, chi=FILLER_CHI if chi is None else chi, d0="initial")
     return fid

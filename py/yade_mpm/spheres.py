@@ -12,7 +12,9 @@ Each body is one rigid part of the contact core with its own contact group: a sp
 circle (2D) / sphere (3D), a clump one per member, in the clump's frame. The contact reaction (force
 and its moment about the body's centre) goes to ``O.forces`` after the MPM step, the opposite force to
 the MPM grid nodes, so NewtonIntegrator moves the spheres; sphere–sphere contacts stay with YADE's
-collider and interaction loop.
+collider and interaction loop. Each active body's mass and inertia (``bodies.body_inertia``; 3D: the
+smallest principal moment on every axis) go to the solver every step: the stick step of the friction
+moves a free sphere with its contact nodes (doc/contact.md).
 
 Broad phase (far spheres cost almost nothing): a body is *active* (its group enabled, its state sent
 to the solver, its reaction read back) only while its bounding circle/sphere comes within ``reach``
@@ -38,7 +40,7 @@ import time
 
 import numpy as np
 
-from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec, _yade_body
+from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec, _yade_body, body_inertia
 from .scene import dim_of
 
 
@@ -217,6 +219,12 @@ class DemSpheres:
         v = np.array([[q.vel[a] for a in range(d)] for q in st])
         w = np.array([[q.angVel[2]] for q in st]) if d == 2 else np.array([[q.angVel[a] for a in range(3)] for q in st])
         s.setRigidPartMotions(self.parts[k], x, v, w)
+        mI = [body_inertia(O.bodies[int(self.ids[j])], d, self.thick[j]) for j in k]
+        m = np.array([a for a, _ in mI])
+        # 3D: the part frame of a clump is not its principal frame; its smallest moment on every axis
+        # (a lower bound: the stick step expects more turning than the clump makes; it sticks less, never overshoots)
+        I = np.array([[b] if d == 2 else [min(b)] * 3 for _, b in mI])
+        s.setRigidPartMasses(self.parts[k], m, I)
 
     @_timed
     def write(self):
