@@ -183,11 +183,15 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d):
     assert checked >= 10
 
 
-def test_contact_is_bitwise_identical_for_1_and_2_threads():
+@pytest.mark.parametrize("free", [False, True])
+def test_contact_is_bitwise_identical_for_1_and_2_threads(free):
+    """free: the incline is a free part (its mass and inertia set; the stick step's body response)."""
     def run(n):
         ym.setThreads(n)
         try:
             s, *_ = _block_on_incline(2, np.radians(30), 0.3)
+            if free:
+                s.setRigidPartMass(0, 5.0, 0.5)
             for _ in range(150):
                 s.step()
             return ym.get(s, "pos"), ym.get(s, "vel"), s.rigidPartForce(0)
