@@ -220,32 +220,21 @@ public:
 				});
 			}
 			// 2. stick / slip per node, Eqs. 24–26
-			const Real mu = g.params.mu, coh = g.params.cohesion;
-			const bool onePart = g.parts.size() == 1;
+			const bool onePart   = g.parts.size() == 1;
 			auto       stickSlip = [&](size_t j, const Motion* resp) {
 				const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
-				Vec          fn;
-				for (int a = 0; a < D; ++a) fn[a] = A.fn[a][i];
-				const Real fnorm = fn.norm();
-				auto&      nd    = grid.nodes[i];
-				if (fnorm == 0 || !(nd.m > massFloor)) return;
-				const Vec xi = grid.position(i);
-				const int pi = onePart ? g.parts[0] : g.query(xi).part;
-				const Vec nrm = fn / fnorm;
-				Vec       v;
-				for (int a = 0; a < D; ++a) v[a] = nd.a[a];
-				Vec rel = v + (dt / nd.m) * fn - parts[pi].velocityAt(xi); // Eq. 26
-				Vec vt  = rel - rel.dot(nrm) * nrm;                        // Eq. 25
-				if (resp) vt -= tangential(resp[pi].at(xi - parts[pi].c), nrm); // against the body's motion after the step
-				Vec ft  = (-nd.m / dt) * vt;                               // f_stick
-				const Real fmax = mu * A.load[i] + A.area[i] * coh; // Coulomb limit of Eq. 24
-				const Real fs   = ft.norm();
-				if (fs >= fmax) ft *= fs > 0 ? fmax / fs : 0; // Eq. 24: slip at the Coulomb limit
-				const Vec     f   = fn + ft;
+				ContactNode  c;
+				if (!contactNode(grid, g, i, dt, massFloor, c)) return;
+				Vec vt = c.vt;
+				if (resp) vt -= tangential(resp[c.part].at(c.r), c.n); // against the body's motion after the step
+				Vec        ft = (-c.m / dt) * vt;                        // f_stick
+				const Real fs = ft.norm();
+				if (fs >= c.fmax) ft *= fs > 0 ? c.fmax / fs : 0; // Eq. 24: slip at the Coulomb limit
+				const Vec     f   = c.fn + ft;
 				const uint8_t fix = grid.fixMask[i];
 				for (int a = 0; a < D; ++a) {
-					nd.a[a]     = (fix >> a) & 1 ? 0.0 : v[a] + dt * f[a] / nd.m;
-					A.force[a][i]  = f[a];
+					grid.nodes[i].a[a] = (fix >> a) & 1 ? 0.0 : c.v[a] + dt * f[a] / c.m;
+					A.force[a][i]      = f[a];
 				}
 			};
 			if (!wk.movable) {
@@ -279,7 +268,7 @@ public:
 private:
 	struct Work {
 		bool skip = true;
-		bool movable = false; // a part of the group is free (finite mass or inertia): stick step with α < 1
+		bool movable = false; // a part of the group is free (finite mass or inertia): stick step with its response
 		IVec blo, bhi; // block coordinate range of the particle pass
 		IVec nlo, nhi; // stored node coordinate range of the node pass
 		Real reach = 0;
@@ -304,28 +293,27 @@ private:
 		return g;
 	}
 
-	// A contact node of a group as the body response sees it (Eqs. 25–26): its part, lever arm, normal,
-	// tangential relative velocity, mass, share in the body's reaction (symmetry planes) and Coulomb limit.
+	// A contact node of a group (f_nor ≠ 0, mass above the floor): its normal force f_nor and velocity v, the
+	// part owning the nearest surface point, lever arm r = x − c, normal n, tangential relative velocity ṽ_tan
+	// (Eqs. 25–26), mass, share in the body's reaction (symmetry planes) and Coulomb limit μ N_i + A_i c.
 	struct ContactNode {
 		int  part;
-		Vec  r, n, vt;
+		Vec  fn, v, r, n, vt;
 		Real m, share, fmax;
 	};
 	bool contactNode(const Grid<D>& grid, const RigidGroup<D>& g, size_t i, Real dt, Real massFloor, ContactNode& c) const
 	{
 		const auto& A = nodeArr;
-		Vec         fn;
-		for (int a = 0; a < D; ++a) fn[a] = A.fn[a][i];
-		const Real  fnorm = fn.norm();
+		for (int a = 0; a < D; ++a) c.fn[a] = A.fn[a][i];
+		const Real  fnorm = c.fn.norm();
 		const auto& nd    = grid.nodes[i];
 		if (fnorm == 0 || !(nd.m > massFloor)) return false;
 		const Vec xi = grid.position(i);
 		c.part       = g.parts.size() == 1 ? g.parts[0] : g.query(xi).part;
 		const auto& q = parts[c.part];
-		Vec         v;
-		for (int a = 0; a < D; ++a) v[a] = nd.a[a];
-		c.n    = fn / fnorm, c.r = xi - q.c;
-		c.vt   = tangential(v + (dt / nd.m) * fn - q.velocityAt(xi), c.n); // Eqs. 25–26
+		for (int a = 0; a < D; ++a) c.v[a] = nd.a[a];
+		c.n  = c.fn / fnorm, c.r = xi - q.c;
+		c.vt = tangential(c.v + (dt / nd.m) * c.fn - q.velocityAt(xi), c.n); // Eqs. 26, 25
 		c.m    = nd.m;
 		c.share = grid.hasMirrors() ? grid.mirrorShare(i) : 1;
 		c.fmax = g.params.mu * A.load[i] + A.area[i] * g.params.cohesion; // Coulomb limit of Eq. 24
