@@ -6,6 +6,7 @@
 #pragma once
 #include "Grid.hpp"
 #include "Particles.hpp"
+#include <algorithm>
 #include <vector>
 
 namespace mpm {
@@ -20,6 +21,7 @@ struct BlockSchedule {
 	IVec                  nBlocks;
 	std::vector<uint32_t> start;               // particles of block b: [start[b], start[b+1])
 	std::vector<uint32_t> colour[1 << D];      // non-empty blocks per colour
+	std::vector<uint32_t> colourCum[1 << D];   // particles in colour[c][0..k), k = 0..size (thread shares)
 	std::vector<uint32_t> perm, count, key;    // sort work arrays (kept: no allocation while stepping)
 	std::vector<Real>     tmp;
 	std::vector<int64_t>  idTmp;
@@ -106,7 +108,29 @@ struct BlockSchedule {
 			for (int a = 0; a < D; ++a) k |= (bc[a] & 1) << a;
 			colour[k].push_back(uint32_t(b));
 		}
+		for (int c = 0; c < (1 << D); ++c) {
+			colourCum[c].assign(1, 0);
+			for (uint32_t b : colour[c]) colourCum[c].push_back(colourCum[c].back() + (start[b + 1] - start[b]));
+		}
 	}
+
+	// Thread t of T takes the entries [k0, k1) of a sequence whose particle counts have the prefix sums
+	// cum[0..n] (cum[0] = 0): contiguous runs of about equal particle counts. A thread then works on the same
+	// part of the domain in every pass of a step (its nodes and particles stay in its core's caches), which
+	// dynamic scheduling does not give. Which thread sums a block does not change any result.
+	static void share(const uint32_t* cum, size_t n, int t, int T, size_t& k0, size_t& k1)
+	{
+		const uint64_t total = cum[n];
+		auto           at    = [&](int i) {
+			const uint64_t target = total * uint64_t(i) / uint64_t(T);
+			return size_t(std::lower_bound(cum, cum + n + 1, target) - cum);
+		};
+		k0 = t == 0 ? 0 : std::min(at(t), n);
+		k1 = t + 1 == T ? n : std::min(at(t + 1), n);
+	}
+	// Blocks of colour c for thread t of T (scatter passes), and all blocks (index order) for the particle passes.
+	void colourShare(int c, int t, int T, size_t& k0, size_t& k1) const { share(colourCum[c].data(), colour[c].size(), t, T, k0, k1); }
+	void blockShare(int t, int T, size_t& b0, size_t& b1) const { share(start.data(), start.size() - 1, t, T, b0, b1); }
 };
 
 } // namespace mpm

@@ -9,6 +9,8 @@
 #include "BlockSchedule.hpp"
 #include "Kinematics.hpp"
 #include "Lanes.hpp"
+#include <atomic>
+#include <omp.h>
 
 namespace mpm {
 
@@ -31,13 +33,35 @@ public:
 	}
 	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums);
 	// fb(b) handles block b. scatterPass(f) calls f(p) for every particle of every block.
+	// Thread t first takes its own share of each colour (BlockSchedule::colourShare: contiguous, equal particle
+	// counts), the same part of the grid in every pass of a step, so the nodes it sums stay in its core's caches
+	// (dynamic scheduling hands blocks out in turn and moves every node line between the cores); then it helps
+	// with what is left of the other shares (a preempted or slower thread does not hold the colour up). Blocks
+	// are claimed through per-share counters; which thread sums a block changes no result.
 	template <class FB>
 	void scatterBlocks(FB&& fb) const
 	{
+		const int T = omp_get_num_threads(), t = omp_get_thread_num();
+		if (T > maxShares) { // more threads than counters: plain dynamic scheduling
+			for (int c = 0; c < Dim<D>::nColours; ++c) {
+				const auto& blocks = sched.colour[c];
+#pragma omp for schedule(dynamic, 1)
+				for (size_t k = 0; k < blocks.size(); ++k) fb(blocks[k]);
+			}
+			return;
+		}
 		for (int c = 0; c < Dim<D>::nColours; ++c) {
 			const auto& blocks = sched.colour[c];
-#pragma omp for schedule(dynamic, 1)
-			for (size_t k = 0; k < blocks.size(); ++k) fb(blocks[k]);
+			for (int j = 0; j < T; ++j) {
+				const int u = (t + j) % T; // own share first, then the others'
+				size_t    k0, k1;
+				sched.colourShare(c, u, T, k0, k1);
+				auto& next = claimed[c][u].n;
+				for (size_t k = k0 + next.fetch_add(1, std::memory_order_relaxed); k < k1; k = k0 + next.fetch_add(1, std::memory_order_relaxed))
+					fb(blocks[k]);
+			}
+#pragma omp barrier
+			claimed[c][t].n.store(0, std::memory_order_relaxed); // unused until this pass's next call: barriers lie between
 		}
 	}
 	template <class F>
@@ -210,6 +234,13 @@ public:
 	}
 
 private:
+	// Blocks claimed so far of colour c's share u in the running scatter pass (scatterBlocks), one cache line each.
+	static constexpr int maxShares = 64;
+	struct alignas(64) Counter {
+		std::atomic<size_t> n { 0 };
+	};
+	mutable Counter claimed[Dim<D>::nColours][maxShares];
+
 	void storeVelocity(size_t p, const Real (&v)[D], const Real (&C)[D][D])
 	{
 		for (int a = 0; a < D; ++a) {
