@@ -114,23 +114,21 @@ struct BlockSchedule {
 		}
 	}
 
-	// Thread t of T takes the entries [k0, k1) of a sequence whose particle counts have the prefix sums
-	// cum[0..n] (cum[0] = 0): contiguous runs of about equal particle counts. A thread then works on the same
-	// part of the domain in every pass of a step (its nodes and particles stay in its core's caches), which
-	// dynamic scheduling does not give. Which thread sums a block does not change any result.
-	static void share(const uint32_t* cum, size_t n, int t, int T, size_t& k0, size_t& k1)
+	// Share t of T of the blocks of colour c (Transfer::scatterBlocks): the entries [k0, k1) of colour[c],
+	// contiguous runs of about equal particle counts.
+	void colourShare(int c, int t, int T, size_t& k0, size_t& k1) const
 	{
-		const uint64_t total = cum[n];
-		auto           at    = [&](int i) {
+		if (colour[c].empty()) return void(k0 = k1 = 0);
+		const uint32_t* cum   = colourCum[c].data();
+		const size_t    n     = colour[c].size();
+		const uint64_t  total = cum[n];
+		auto            at    = [&](int i) {
 			const uint64_t target = total * uint64_t(i) / uint64_t(T);
-			return size_t(std::lower_bound(cum, cum + n + 1, target) - cum);
+			return std::min(size_t(std::lower_bound(cum, cum + n + 1, target) - cum), n);
 		};
-		k0 = t == 0 ? 0 : std::min(at(t), n);
-		k1 = t + 1 == T ? n : std::min(at(t + 1), n);
+		k0 = t == 0 ? 0 : at(t);
+		k1 = t + 1 == T ? n : at(t + 1);
 	}
-	// Blocks of colour c for thread t of T (scatter passes), and all blocks (index order) for the particle passes.
-	void colourShare(int c, int t, int T, size_t& k0, size_t& k1) const { share(colourCum[c].data(), colour[c].size(), t, T, k0, k1); }
-	void blockShare(int t, int T, size_t& b0, size_t& b1) const { share(start.data(), start.size() - 1, t, T, b0, b1); }
 };
 
 } // namespace mpm

@@ -1,5 +1,5 @@
 // C++ unit tests of the core that need no Python: WLS shape functions against the closed form and
-// linear reproduction, and one DP return landing on the yield surface.
+// linear reproduction, one DP return landing on the yield surface, and the threads' shares of the block colours.
 #include "Solver.hpp"
 #include "Check.hpp"
 #include <cstdio>
@@ -58,8 +58,48 @@ void dpChecks()
 	CHECK(std::abs(F) < 1e-8 * m.cohesion, "on yield surface F = %g", F);
 }
 
+// BlockSchedule::colourShare: for T threads the shares of a colour tile its block list in order, and each holds
+// total/T particles to within one block (particles clustered on one side, an empty hole in the middle).
+void shareChecks()
+{
+	Dim<2>::IVec n(160, 96); // 20 × 12 blocks
+	Grid<2>      g(Dim<2>::Vec::Zero(), 0.025, n);
+	Particles<2> P;
+	std::mt19937 rng(3);
+	std::uniform_real_distribution<double> U(0.0, 1.0);
+	std::vector<Real> x, vol, mass;
+	for (int i = 0; i < 20000; ++i) {
+		const Real px = 4.0 * U(rng) * U(rng), py = 2.4 * U(rng); // denser towards x = 0
+		if (std::abs(px - 2.0) < 0.5 && std::abs(py - 1.2) < 0.5) continue; // the hole
+		x.push_back(px), x.push_back(py), vol.push_back(1e-4), mass.push_back(0.25);
+	}
+	P.append(x.data(), vol.data(), mass.data(), vol.size(), g.origin, g.upper(), 0);
+	BlockSchedule<2> s;
+	s.sort(g, P);
+	for (int c = 0; c < Dim<2>::nColours; ++c) {
+		const auto& bl    = s.colour[c];
+		uint32_t    total = 0, biggest = 0;
+		for (uint32_t b : bl) total += s.start[b + 1] - s.start[b], biggest = std::max(biggest, s.start[b + 1] - s.start[b]);
+		for (int T = 1; T <= 4; ++T) {
+			size_t end = 0;
+			for (int t = 0; t < T; ++t) {
+				size_t k0, k1;
+				s.colourShare(c, t, T, k0, k1);
+				CHECK(k0 == end && k1 >= k0, "colour %d, T = %d: share %d is [%zu, %zu), expected to start at %zu", c, T, t, k0, k1, end);
+				end = k1;
+				uint32_t cnt = 0;
+				for (size_t k = k0; k < k1; ++k) cnt += s.start[bl[k] + 1] - s.start[bl[k]];
+				CHECK(std::abs(double(cnt) - double(total) / T) <= biggest, "colour %d, T = %d: share %d holds %u of %u particles (block ≤ %u)", c, T, t, cnt,
+				      total, biggest);
+			}
+			CHECK(end == bl.size(), "colour %d, T = %d: shares end at %zu of %zu blocks", c, T, end, bl.size());
+		}
+	}
+}
+
 int main()
 {
+	shareChecks();
 	shapeChecks<2>();
 	shapeChecks<3>();
 	dpChecks();
