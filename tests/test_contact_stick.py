@@ -94,6 +94,31 @@ def test_box_sheared_between_two_slabs_stops_both_faces():
     assert abs(s.rigidPartForce(p)[0]) < 1e-9 * S * v0 / s.time             # the box stays at rest
 
 
+def test_two_free_parts_of_one_group_each_take_their_own_response():
+    """One contact group over two free boxes (rotation prescribed) of different masses side by side on a
+    slab, both sliding at v0: each node gets the reduced mass of the box that owns its nearest surface
+    point, f_x/m_i = v0 M_k/(M_k + S_k)/Δt with S_k the mass of box k's contact nodes (per-part sums)."""
+    v0, Ms, inf = 0.1, (0.2, 3.0), float("inf")
+    s = ym.make_solver((0, 0), (0.4, 0.2), L)
+    ym.add_region(s, ym.ElasticMat(**SLAB), (0.0, 0.0), (0.4, TOP))
+    parts = [s.addRigidPart(), s.addRigidPart()]
+    g = s.addContactGroup(parts, 10.0, 0.0, 0.5, None)
+    for k, p in enumerate(parts):
+        s.addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.09, 0.02))
+        s.setRigidPartState(p, (0.1 + 0.2 * k, TOP + 0.02 - 0.002), np.eye(2), (v0, 0.0), 0.0)
+        s.setRigidPartMass(p, Ms[k], inf)
+    dt, f, m, on = _one_step(s)
+    x = s.nodePositions()
+    owner = np.array([s.contactQuery(g, tuple(xi))[2] for xi in x[on]])
+    for k, p in enumerate(parts):
+        mine = owner == p
+        S = m[on][mine].sum()
+        assert S > 0
+        alpha = Ms[k] / (Ms[k] + S)
+        assert np.allclose(f[on][mine, 0] / m[on][mine], alpha * v0 / dt, rtol=1e-12, atol=0)
+        assert s.rigidPartForce(p)[0] == pytest.approx(-alpha * S * v0 / dt, rel=1e-12)
+
+
 @pytest.mark.parametrize("d", [2, 3])
 def test_free_rotation_every_node_sticks_to_the_body_in_one_step(d):
     """A free box that also turns (I = ½ M h² about every axis, a disc whose centre is h = 2 cm above its
