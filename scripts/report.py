@@ -289,8 +289,9 @@ def readme_figure(R, part="tunnel", case="filled_flaw"):
     plt.close(fig)
 
 
-def compare_with_paper(R, cs, info):
-    """The paper's findings for the tunnel (Sec. 4, Figs. 17–19), each checked against our numbers."""
+def compare_with_paper(R, cs, info, paper_cs=None):
+    """The paper's findings for the tunnel (Sec. 4, Figs. 17–19), each checked against our numbers; paper_cs:
+    the paper-grid cases, whose filled-vs-intact count is added to the Fig. 17 row."""
     R.w("## The tunnel against the paper's findings, point by point", "")
     by = {e["case"]: e for e in cs}
     rows = []
@@ -316,6 +317,12 @@ def compare_with_paper(R, cs, info):
         oi = sum(1 for d in ds if stress_at("open_flaw", d) is not None and stress_at("open_flaw", d) < stress_at("intact", d))
         fi = sum(1 for d in ds if stress_at("filled_flaw", d) is not None and stress_at("filled_flaw", d) > stress_at("intact", d))
         verdict = "agrees" if n and len(ok) == n else ("partly" if (oi or fi) else "differs")
+        pby = {e["case"]: {round(p["displacement_mm"], 6): p["stress_MPa"] for p in e["axial_stress_MPa_at"]} for e in paper_cs or []}
+        if "intact" in pby and "filled_flaw" in pby:
+            common = [d for d in pby["filled_flaw"] if d > 0 and d in pby["intact"]]
+            above = sum(1 for d in common if pby["filled_flaw"][d] > pby["intact"][d])
+            vals += (f"; paper grid (1 mm): filled > intact at {above} of {len(common)} displacements to {max(common):g} mm"
+                     + (f", 1 mm: intact {pby['intact'][1.0]:.1f} / filled {pby['filled_flaw'][1.0]:.1f} MPa" if 1.0 in common else ""))
         rows.append(("Fig. 17: at equal displacement open flaw < intact < rigid-filled flaw; no peak",
                      f"whole ordering at {len(ok)} of {n} displacements (0.1 mm apart); open < intact at {oi}, filled > intact at {fi}; {vals}",
                      verdict))
@@ -407,7 +414,7 @@ def main():
               tunnel(R, "tunnel_paper", "Arch tunnel at the paper's grid (l = 1 mm)", keys_intact=(), keys_flaw=())]
     tun = tparts[0] or tparts[1]
     if tun:
-        compare_with_paper(R, *tun)
+        compare_with_paper(R, *tun, paper_cs=tparts[1][0] if tparts[0] and tparts[1] else None)
         readme_figure(R, "tunnel" if tparts[0] else "tunnel_paper")
     circ, pen = R.read("circular_opening"), R.read("penny_crack")
     error_vs_time(R, circ, pen)
