@@ -115,8 +115,6 @@ class CaseRun:
             r = self.x0 - fl["toe"]
             along = np.clip(r @ fl["direction"], 0, fl["length"])
             self.dist_flaw = np.linalg.norm(r - along[:, None] * fl["direction"], axis=1)
-        from yade import O
-        self.platen_y0 = O.bodies[self.bodies["platen"]].state.pos[1]
         # recorder state (saved with each checkpoint)
         self.state = dict(curve=[], acc=[0.0, 0], first_crack=None, wall=0.0, steps_run=0, done=False, snapshots=[])
 
@@ -127,11 +125,10 @@ class CaseRun:
 
     # ---- recorders
     def displacement(self):
-        from yade import O
-        return self.platen_y0 - O.bodies[self.bodies["platen"]].state.pos[1]
+        return self.bodies["platen_displacement"]()                          # [m]
 
     def stress(self):
-        return self.bodies["rigid"].force(self.bodies["platen"])[1] / self.W     # [Pa], compression positive
+        return self.bodies["axial_stress"]()                                 # [Pa], compression positive
 
     def record(self, solver):
         acc = self.state["acc"]

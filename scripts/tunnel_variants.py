@@ -16,7 +16,6 @@ import math
 import os
 import time
 
-import yade_mpm as ym
 from yade_mpm import cases, rocks, runner
 
 MARKS_MM = (0.25, 0.5, 0.75, 1.0, 1.5, 2.0)
@@ -46,27 +45,25 @@ def parse():
 
 
 def rock(kind):
-    sand = rocks.pan2020_sandstone()
     if kind == "dp":
         return rocks.pan2020_sandstone(damage=False)
     if kind == "elastic":
-        return ym.ElasticMat(young=sand.young, poisson=sand.poisson, density=sand.density)
-    return sand
+        return rocks.elastic(rocks.PAN2020_SANDSTONE)
+    return rocks.pan2020_sandstone()
 
 
 def main():
     a = parse()
     from yade import O
     s, b = cases.arch_tunnel(a.case, a.spacing, material=rock(a.rock), filler_friction=a.filler_friction)
-    y0 = O.bodies[b["platen"]].state.pos[1]
     marks = [m for m in MARKS_MM if m * 1e-3 <= cases.PLATEN_SPEED * a.end_time * (1 + 1e-9)]
     at = {}
 
     def record(solver):
-        d = y0 - O.bodies[b["platen"]].state.pos[1]
+        d = b["platen_displacement"]()
         for m in marks:
             if m not in at and d >= m * 1e-3 - 1e-12:
-                at[m] = b["rigid"].force(b["platen"])[1] / b["width"] / 1e6
+                at[m] = b["axial_stress"]() / 1e6
 
     label = f"{a.case}/{a.rock}/mu={a.filler_friction:g}/l={a.spacing * 1e3:g}mm"
     t0 = time.time()

@@ -183,7 +183,9 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
-    engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m])."""
+    engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
+    axial_stress() -> platen reaction / width [Pa, compression positive],
+    platen_displacement() -> downward platen displacement since the build [m])."""
     if case not in TUNNEL_CASES:
         raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
     if not (isinstance(spacing, (int, float)) and 0 < spacing <= TUNNEL_MAX_SPACING):
@@ -206,7 +208,15 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction)
     filler = yade_filler(rb, flaw, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
     eng = yade_engines(s, rb, label)
-    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W)
+    y0 = O.bodies[platen].state.pos[1]
+
+    def axial_stress():
+        return rb.force(platen)[1] / W             # the rock pushes the platen up: compression positive
+
+    def platen_displacement():
+        return y0 - O.bodies[platen].state.pos[1]
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W,
+                   axial_stress=axial_stress, platen_displacement=platen_displacement)
 
 
 # ------------------------------------------------------------------------------------------------
