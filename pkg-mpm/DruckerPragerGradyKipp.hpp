@@ -7,24 +7,6 @@
 
 namespace mpm {
 
-// V of Eq. 37. The paper: "the volume of the material particle"; plane strain leaves the thickness open.
-enum class ThresholdVolume : int {
-	Particle     = 0, // the particle volume vol0 (2D: area × 1 m, the code's per-unit-thickness convention; literal)
-	SpacingCubed = 1, // dp³, dp = vol0^(1/D) the particle spacing (a particle as a cube of its own size)
-	CellSpacing  = 2  // l²·dp, l the grid spacing (2D: cell area × particle spacing)
-};
-
-// ε̄ of Eq. 36.
-enum class DamageStrain : int {
-	PrintedEq36      = 0, // σ̃max/(K + 4G/3): the uniaxial-strain value of the maximum principal stress (as printed)
-	PrincipalStrain  = 1  // ((1 + ν)σ1 − ν tr σ)/E: the true maximum principal elastic strain of the state stress
-};
-
-enum class DamageGrowthLaw : int {
-	BenzAsphaug = 0, // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{m/3}: Grady–Kipp / Benz–Asphaug (default)
-	AsPrinted   = 1  // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{1/3}: Eq. 38 exactly as printed
-};
-
 struct DpGkMat : ElasticMat {
 	MPM_PARAMS(DpGkMat, ElasticMat, MPM_DPGK_PARAMS) // plasticity, damage, φ, ψ, c₀, … (MaterialParams.hpp)
 
@@ -61,7 +43,7 @@ struct DpGkMat : ElasticMat {
 	Real thresholdVolumeOf(Real vol0, Real l, int dim) const
 	{
 		const Real dp = std::pow(vol0, 1.0 / dim); // particle spacing
-		switch (ThresholdVolume(thresholdVolume)) {
+		switch (thresholdVolume) {
 			case ThresholdVolume::Particle: return vol0;
 			case ThresholdVolume::SpacingCubed: return dp * dp * dp;
 			default: return l * l * dp;
@@ -84,7 +66,7 @@ struct DpGkMat : ElasticMat {
 		if (!(e > 0 && e < 1)) {
 			const Real V = thresholdVolumeOf(vol0, l, dim);
 			throw InputError("damage threshold eps0 = (V·weibullK)^(−1/weibullM) = " + ParamInfo::num(e) + " for V = " + ParamInfo::num(V)
-			                 + " m³ (particle volume " + ParamInfo::num(vol0) + " m³, thresholdVolume = " + std::to_string(thresholdVolume)
+			                 + " m³ (particle volume " + ParamInfo::num(vol0) + " m³, thresholdVolume = '" + paramWord(thresholdVolume) + "'"
 			                 + ") is outside the allowed range (0, 1) (weibullK = " + ParamInfo::num(weibullK) + " m^-3, weibullM = " + ParamInfo::num(weibullM)
 			                 + "; V·weibullK = " + ParamInfo::num(V * weibullK) + " must exceed 1: at least one flaw per particle)");
 		}
@@ -209,7 +191,7 @@ struct DruckerPragerGradyKipp {
 	// ε̄ of Eq. 36 from the undamaged state stress (smax = its maximum principal value).
 	Real damageStrain(const Sym<D>& s, Real smax) const
 	{
-		if (mat.damageStrain == int(DamageStrain::PrintedEq36)) return smax / M;
+		if (mat.damageStrain == DamageStrain::Uniaxial) return smax / M;
 		return ((1 + nu) * smax - nu * (s.c[0] + s.c[1] + s.c[2])) / E; // max principal elastic strain
 	}
 
@@ -242,7 +224,7 @@ struct DruckerPragerGradyKipp {
 			cap = Real(n) / N;
 		}
 		const Real m    = mat.weibullM;
-		const Real rate = cg * alpha13 / 3 * (mat.growthLaw == 0 ? std::pow(eb, m / 3) : std::cbrt(eb)); // Eq. 38
+		const Real rate = cg * alpha13 / 3 * (mat.growthLaw == DamageGrowthLaw::BenzAsphaug ? std::pow(eb, m / 3) : std::cbrt(eb)); // Eq. 38
 		const Real d13  = std::cbrt(Dmg) + rate * dt;
 		Dmg             = d13 >= 1 ? 1.0 : d13 * d13 * d13;
 		if (Dmg > cap) Dmg = cap;

@@ -6,6 +6,29 @@
 #pragma once
 #include "ParamTable.hpp"
 
+namespace mpm {
+// Named options of DpGkMat (Python sees the words; enumerator k = word k).
+// V of Eq. 37. The paper: "the volume of the material particle"; plane strain leaves the thickness open.
+enum class ThresholdVolume : int {
+	Particle     = 0, // the particle volume vol0 (2D: area × 1 m, per unit thickness; literal, the reference code's)
+	SpacingCubed = 1, // dp³, dp = vol0^(1/D) the particle spacing (calibration: picked to fit Fig. 9)
+	CellSpacing  = 2  // l²·dp, l the grid spacing (2D: cell area × particle spacing)
+};
+MPM_CHOICES(ThresholdVolume, "particle|cube|cell")
+// ε̄ of Eq. 36.
+enum class DamageStrain : int {
+	Uniaxial        = 0, // σ̃max/(K + 4G/3): the strain of the maximum principal stress under uniaxial strain (as printed)
+	PrincipalStrain = 1  // ((1 + ν)σ1 − ν tr σ)/E: the true maximum principal elastic strain of the state stress
+};
+MPM_CHOICES(DamageStrain, "uniaxial|principal")
+// Eq. 38.
+enum class DamageGrowthLaw : int {
+	BenzAsphaug = 0, // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{m/3}: Grady–Kipp / Benz–Asphaug (default)
+	AsPrinted   = 1  // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{1/3}: Eq. 38 exactly as printed
+};
+MPM_CHOICES(DamageGrowthLaw, "benz-asphaug|as-printed")
+} // namespace mpm
+
 // X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
 #define MPM_ELASTIC_PARAMS(X)                                                                                  \
 	X(Real, young, MPM_REQUIRED, "Pa", 0, INFINITY, OO, "E", "Young's modulus", "Eqs. 27–28", "")              \
@@ -28,14 +51,16 @@
 	X(Real, weibullK, MPM_REQUIRED, "m^-3", 0, INFINITY, OO, "k", "Weibull flaw density", "Eqs. 37, 39", "damage")              \
 	X(Real, weibullM, MPM_REQUIRED, "-", 1, 50, CC, "m", "Weibull modulus", "Eqs. 37–39", "damage")                              \
 	X(Real, crackSpeed, 0, "m/s", 0, INFINITY, CO, "c_g", "crack growth speed; 0 = 0.4 × P-wave speed", "Eq. 38", "damage")     \
-	X(int, growthLaw, 0, "-", 0, 1, CC, "",                                                                                      \
-	  "damage growth law: 0 = Grady–Kipp/Benz–Asphaug dD^⅓/dt ∝ ε̄^(m/3), 1 = Eq. 38 as printed ∝ ε̄^(1/3)", "Eq. 38", "damage") \
-	X(int, thresholdVolume, 1, "-", 0, 2, CC, "V",                                                                               \
-	  "V of Eq. 37 in m³: 0 = particle volume (2D: area × 1 m, literal), 1 = dp³ (particle spacing cubed), 2 = l²·dp "            \
-	  "(grid spacing² × particle spacing); see doc/damage_growth_law.md", "Eq. 37", "damage")                                   \
-	X(int, damageStrain, 0, "-", 0, 1, CC, "ε̄",                                                                                 \
-	  "tensile strain of Eq. 36: 0 = σ̃max/(K + 4G/3) as printed, 1 = maximum principal elastic strain of the state stress",     \
-	  "Eqs. 35–36", "damage")                                                                                                    \
+	X(DamageGrowthLaw, growthLaw, DamageGrowthLaw::BenzAsphaug, "-", 0, 1, CC, "",                                             \
+	  "damage growth law: 'benz-asphaug' = Grady–Kipp/Benz–Asphaug dD^⅓/dt ∝ ε̄^(m/3), 'as-printed' = Eq. 38 as printed ∝ ε̄^(1/3)", \
+	  "Eq. 38", "damage")                                                                                                        \
+	X(ThresholdVolume, thresholdVolume, ThresholdVolume::Particle, "-", 0, 2, CC, "V",                                          \
+	  "V of Eq. 37 in m³: 'particle' = the particle volume (2D: area × 1 m; the paper's text and the reference code), "         \
+	  "'cube' = dp³ (particle spacing cubed; calibration, picked to fit Fig. 9), 'cell' = l²·dp (grid spacing² × particle "     \
+	  "spacing); see doc/damage_growth_law.md", "Eq. 37", "damage")                                                              \
+	X(DamageStrain, damageStrain, DamageStrain::Uniaxial, "-", 0, 1, CC, "ε̄",                                                  \
+	  "tensile strain of Eq. 36: 'uniaxial' = σ̃max/(K + 4G/3) as printed, 'principal' = maximum principal elastic strain of "   \
+	  "the state stress", "Eqs. 35–36", "damage")                                                                                \
 	X(Real, thresholdCell, 0, "m", 0, INFINITY, CO, "l_ref",                                                                     \
 	  "regularised threshold: ε_D⁰ of the l_ref grid scaled by √(l_ref/l), same effective toughness on every grid; 0 = off",   \
 	  "Eq. 37", "damage")                                                                                                        \

@@ -2,7 +2,9 @@
 //
 // A parameter list is an X-macro: one line per parameter with
 //   X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
-// - type    Real, int or bool (the binding layer also accepts Dim<D>::Vec, range per component)
+// - type    Real, int or bool (the binding layer also accepts Dim<D>::Vec, range per component), or a named
+//           option: an enum with MPM_CHOICES(Enum, "word0|word1|…") (Python sees and sets the words only;
+//           default = an enumerator; lo, hi = 0, count − 1)
 // - default the value a new object gets; MPM_REQUIRED = no default, must be set (NaN inside)
 // - lo, hi  allowed range, `ends` one of OO, OC, CO, CC (open/closed lower, upper end)
 // - gate    name of a bool parameter of the same object that switches this one on ("" = always);
@@ -32,10 +34,36 @@ struct ParamInfo {
 	const char* doc;
 	const char* eq;   // paper equation numbers, e.g. "Eq. 34" ("" if none)
 	const char* gate; // bool parameter switching this one on ("" = always on)
+	const char* choices = ""; // named option: "word0|word1|…" (word k = enumerator k), "" otherwise
 
 	bool loOpen() const { return ends == OO || ends == OC; }
 	bool hiOpen() const { return ends == OO || ends == CO; }
 	bool required() const { return std::isnan(def); }
+	bool isChoice() const { return *choices != 0; }
+	// The words of a named option, in enumerator order.
+	std::vector<std::string> words() const
+	{
+		std::vector<std::string> w(1);
+		for (const char* c = choices; *c; ++c)
+			if (*c == '|') w.emplace_back();
+			else w.back() += *c;
+		return w;
+	}
+	// "'particle', 'cube' or 'cell'"
+	std::string wordsText() const
+	{
+		const auto  w = words();
+		std::string t;
+		for (size_t k = 0; k < w.size(); ++k) t += (k == 0 ? "" : k + 1 == w.size() ? " or " : ", ") + ("'" + w[k] + "'");
+		return t;
+	}
+	int wordIndex(const std::string& word) const
+	{
+		const auto w = words();
+		for (size_t k = 0; k < w.size(); ++k)
+			if (w[k] == word) return int(k);
+		return -1;
+	}
 	static std::string num(Real x)
 	{
 		if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
@@ -60,19 +88,43 @@ struct ParamInfo {
 	std::string describe() const
 	{
 		std::string s = (*symbol ? std::string(symbol) + ": " : "") + doc + " [" + unit + "], "
-		                + (std::string(type) == "bool" ? std::string("True or False") : "range " + rangeText());
+		                + (std::string(type) == "bool" ? std::string("True or False") : isChoice() ? "one of " + wordsText() : "range " + rangeText());
 		if (required()) s += ", required" + (*gate ? std::string(" when ") + gate + " is on" : "");
 		else if (std::string(type) == "bool") s += std::string(", default ") + (def != 0 ? "True" : "False");
+		else if (isChoice()) s += ", default '" + words()[size_t(def)] + "'";
 		else s += ", default " + num(def);
 		if (*eq) s += std::string(". ") + eq;
 		return s + ".";
 	}
 };
 
+// Named options: MPM_CHOICES(Enum, "word0|word1|…") after `enum class Enum : int { … }` (enumerators 0, 1, …)
+// declares the words; a parameter of type Enum is then exposed to Python as these words.
+template <class T>
+struct ParamChoices {
+	static constexpr const char* words = "";
+};
+#define MPM_CHOICES(Enum, WORDS)                       \
+	template <>                                        \
+	struct ParamChoices<Enum> {                        \
+		static constexpr const char* words = WORDS;    \
+	};
+
+// The word of a named option's value ("particle").
+template <class E>
+std::string paramWord(E e)
+{
+	ParamInfo p {};
+	p.choices = ParamChoices<E>::words;
+	const auto w = p.words();
+	return size_t(e) < w.size() ? w[size_t(e)] : std::to_string(int(e));
+}
+
 template <class T>
 constexpr const char* paramTypeName()
 {
-	if constexpr (std::is_same_v<T, bool>) return "bool";
+	if constexpr (std::is_enum_v<T>) return "choice";
+	else if constexpr (std::is_same_v<T, bool>) return "bool";
 	else if constexpr (std::is_integral_v<T>) return "int";
 	else if constexpr (std::is_floating_point_v<T>) return "float";
 	else return "vector";
@@ -83,21 +135,24 @@ template <class T>
 Real paramAsReal(const T& v)
 {
 	if constexpr (std::is_arithmetic_v<T>) return Real(v);
+	else if constexpr (std::is_enum_v<T>) return Real(int(v));
 	else return 0;
 }
 
-// Initial value of a field from its declared default (vectors: every component).
+// Initial value of a field from its declared default (vectors: every component; named options: the enumerator).
 template <class T>
 T paramDefault(Real def)
 {
-	if constexpr (std::is_arithmetic_v<T>) return T(def);
+	if constexpr (std::is_enum_v<T>) return T(int(def));
+	else if constexpr (std::is_arithmetic_v<T>) return T(def);
 	else return T::Constant(def);
 }
 
 #define MPM_REQUIRED std::numeric_limits<double>::quiet_NaN()
-#define MPM_PARAM_FIELD_(T, name, def, ...) T name = ::mpm::paramDefault<T>(def);
-#define MPM_PARAM_INFO_(T, name, def, unit, lo, hi, ends, sym, doc, eq, gate) \
-	::mpm::ParamInfo { #name, ::mpm::paramTypeName<T>(), ::mpm::Real(def), unit, ::mpm::Real(lo), ::mpm::Real(hi), ends, sym, doc, eq, gate },
+#define MPM_PARAM_FIELD_(T, name, def, ...) T name = ::mpm::paramDefault<T>(::mpm::paramAsReal(def));
+#define MPM_PARAM_INFO_(T, name, def, unit, lo, hi, ends, sym, doc, eq, gate)                                                          \
+	::mpm::ParamInfo { #name, ::mpm::paramTypeName<T>(), ::mpm::paramAsReal(def), unit, ::mpm::Real(lo), ::mpm::Real(hi), ends, sym, doc, eq, gate, \
+		           ::mpm::ParamChoices<T>::words },
 #define MPM_PARAM_VISIT_(T, name, ...) f(info[i++], &Self_::name);
 
 // Inside a struct: fields, table, member visitor, range validation. Base = a struct with

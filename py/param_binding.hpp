@@ -43,7 +43,13 @@ template <class T>
 T pyToParam(const bp::object& o, const std::string& who, const ParamInfo& p)
 {
 	PyObject* q = o.ptr();
-	if constexpr (std::is_same_v<T, bool>) {
+	if constexpr (std::is_enum_v<T>) { // named option: one of its words; the old integer codes are refused
+		const bool isStr = PyUnicode_Check(q);
+		const int  k     = isStr ? p.wordIndex(bp::extract<std::string>(o)) : -1;
+		if (k >= 0) return T(k);
+		throw InputError(who + " must be one of " + p.wordsText() + " (got " + pyTypeName(q) + " " + pyRepr(o) + ")"
+		                 + (isStr ? "" : "; the integer codes were replaced by these words"));
+	} else if constexpr (std::is_same_v<T, bool>) {
 		if (PyBool_Check(q)) return q == Py_True;
 		if (PyIndex_Check(q) && !PyFloat_Check(q)) {
 			long v = PyLong_AsLong(q);
@@ -85,7 +91,8 @@ T pyToParam(const bp::object& o, const std::string& who, const ParamInfo& p)
 template <class T>
 bp::object paramToPy(const T& v)
 {
-	if constexpr (std::is_same_v<T, bool>) return bp::object(bool(v));
+	if constexpr (std::is_enum_v<T>) return bp::str(paramWord(v));
+	else if constexpr (std::is_same_v<T, bool>) return bp::object(bool(v));
 	else if constexpr (std::is_integral_v<T>) return bp::object(long(v));
 	else if constexpr (std::is_floating_point_v<T>) return std::isnan(v) ? bp::object() : bp::object(double(v));
 	else {
@@ -159,6 +166,11 @@ struct ParamBinding {
 		S::forEachMember([&](const ParamInfo& p, auto) {
 			bp::dict e;
 			e["name"] = p.name, e["type"] = p.type, e["default"] = p.required() ? bp::object() : bp::object(p.def);
+			if (p.isChoice()) {
+				bp::list w;
+				for (const auto& x : p.words()) w.append(x);
+				e["choices"] = w, e["default"] = p.words()[size_t(p.def)];
+			}
 			e["unit"] = p.unit, e["lo"] = p.lo, e["hi"] = p.hi, e["loOpen"] = p.loOpen(), e["hiOpen"] = p.hiOpen();
 			e["symbol"] = p.symbol, e["doc"] = p.doc, e["eq"] = p.eq, e["gate"] = p.gate, e["describe"] = p.describe();
 			l.append(e);

@@ -42,7 +42,7 @@ else:
         rock["dilatancyAngle"] = rock.pop("dilationAngle")
         mat = ym.DpGkMat(**rock)
     if hasattr(mat, "thresholdVolume"):
-        mat.thresholdVolume = 0                                # V = particle volume, as before the option
+        mat.thresholdVolume = "particle" if isinstance(mat.thresholdVolume, str) else 0   # V = particle volume (old builds: code 0)
 s = ym.make_solver((0.0, 0.0), (2.0, 1.0), 0.01, margin=3)
 ym.add_region(s, mat, (0.0, 0.0), (2.0, 1.0), ppc=2)
 x0, x1 = s.view("x0"), s.view("x1")

@@ -152,16 +152,15 @@ def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
     plt.close(fig)
 
 
-THRESHOLD_VOLUMES = {"area": 0, "cube": 1, "l2dp": 2}   # DpGkMat.thresholdVolume (V of Eq. 37)
-DAMAGE_STRAINS = {"eq36": 0, "principal": 1}             # DpGkMat.damageStrain (ε̄ of Eq. 36)
+CHOICES = {p["name"]: p["choices"] for p in ym.DpGkMat.paramTable() if p["type"] == "choice"}   # named options
 
 
 def damage_options(args, law):
     """DpGkMat keyword overrides of the damage run selected on the command line."""
-    kw = dict(growthLaw=law, damageStrain=DAMAGE_STRAINS[args.damage_strain], thresholdCell=args.threshold_cell,
+    kw = dict(growthLaw=law, damageStrain=args.damage_strain, thresholdCell=args.threshold_cell,
               flawCount=args.flaws, flawSeed=args.flaw_seed)
     if args.threshold_volume is not None:
-        kw["thresholdVolume"] = THRESHOLD_VOLUMES[args.threshold_volume]
+        kw["thresholdVolume"] = args.threshold_volume
     return kw
 
 
@@ -186,7 +185,7 @@ def run_damage(args, law, outdir):
 
     def snapshot(tp):
         def write(s):
-            tag = f"law{law}_t{tp:.2f}s"
+            tag = f"{law}_t{tp:.2f}s"
             damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
                        f"D, growth law {law}, t_paper = {tp} s (P = {args.damage_pressure * tp / PAPER_RAMP / 1e6:.0f} MPa)")
             if args.vtu:
@@ -200,7 +199,7 @@ def run_damage(args, law, outdir):
     wall = time.time() - t0
     header = ["t_paper_s", "P_Pa", "da_left_cells", "da_right_cells", "broken_particles", "damaged_particles",
               "plastic_particles", "wall_s"]
-    out.write_csv(os.path.join(outdir, f"crack_extension_law{law}.csv"), header, rows)
+    out.write_csv(os.path.join(outdir, f"crack_extension_{law}.csv"), header, rows)
     plastic = int(np.count_nonzero(s.view("epsP") > 0))
     # ε̄p is plastic strain of rock (a fully damaged particle keeps no tension, so an opening crack does not
     # yield); the second count says how many of the yielded particles are not (yet) fully cracked
@@ -279,7 +278,7 @@ def plot_da(results, outdir):
         t = [row[0] for row in r["rows"]]
         cells = PAPER_CELL / r["h"]
         ax.plot(t, [0.5 * (row[2] + row[3]) / cells for row in r["rows"]], "-",
-                label=f"MPM, growth law {r['law']} ({'ε̄^(m/3)' if r['law'] == 0 else 'ε̄^(1/3), as printed'})")
+                label=f"MPM, growth law {r['law']} ({'ε̄^(m/3)' if r['law'] == 'benz-asphaug' else 'ε̄^(1/3), as printed'})")
     ax.plot([p[0] for p in PAPER_DA], [p[1] for p in PAPER_DA], "ks", label="paper Fig. 9")
     ax.set_xlabel("t (paper time scale) [s]")
     ax.set_ylabel("Δa [cells of 0.02 m]")
@@ -306,12 +305,13 @@ def main(argv=None):
     ap.add_argument("--ramp-time", type=float, default=0.02, help="simulated ramp time replacing the paper's 0.5 s [s]")
     ap.add_argument("--end-time", type=float, default=0.4, help="end of the damage run on the paper time axis [s]")
     ap.add_argument("--record-every", type=float, default=0.005, help="Δa record interval on the paper time axis [s]")
-    ap.add_argument("--laws", default="0,1", help="damage growth laws to run: 0 = ε̄^(m/3) (default law), 1 = Eq. 38 as printed")
-    ap.add_argument("--threshold-volume", choices=tuple(THRESHOLD_VOLUMES), default=None,
-                    help="V of Eq. 37 (DpGkMat.thresholdVolume): area = particle area × 1 m (literal), cube = dp³, "
-                         "l2dp = l²·dp; default: the material's default (dp³, doc/damage_growth_law.md)")
-    ap.add_argument("--damage-strain", choices=tuple(DAMAGE_STRAINS), default="eq36",
-                    help="ε̄ of Eq. 36 (DpGkMat.damageStrain): eq36 = σ̃max/(K + 4G/3) as printed, principal = max principal strain")
+    ap.add_argument("--laws", default="benz-asphaug,as-printed",
+                    help="damage growth laws to run (DpGkMat.growthLaw): benz-asphaug = ε̄^(m/3) (default law), as-printed = Eq. 38 as printed")
+    ap.add_argument("--threshold-volume", choices=CHOICES["thresholdVolume"], default=None,
+                    help="V of Eq. 37 (DpGkMat.thresholdVolume): particle = particle area × 1 m (literal), cube = dp³, "
+                         "cell = l²·dp; default: the material's default (particle, doc/damage_growth_law.md)")
+    ap.add_argument("--damage-strain", choices=CHOICES["damageStrain"], default="uniaxial",
+                    help="ε̄ of Eq. 36 (DpGkMat.damageStrain): uniaxial = σ̃max/(K + 4G/3) as printed, principal = max principal strain")
     ap.add_argument("--threshold-cell", type=float, default=0.0,
                     help="regularised threshold: ε_D⁰ of a grid of this spacing [m] scaled by √(l_ref/l) (DpGkMat.thresholdCell); 0 = off")
     ap.add_argument("--flaws", type=int, default=0, help="Benz–Asphaug flaws per particle (DpGkMat.flawCount); 0 = one threshold")
@@ -351,8 +351,7 @@ def main(argv=None):
     summary = dict(config=dict(size_m=a.size, elastic_spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
                                ramp_time_s=PAPER_RAMP if a.full else a.ramp_time, paper_ramp_s=PAPER_RAMP,
                                full=a.full, elastic_damping=a.elastic_damping, damage_damping=a.damage_damping,
-                               threshold_volume=next(k for k, v in THRESHOLD_VOLUMES.items()
-                                                     if v == rocks.granite_dpgk(**damage_options(a, 0)).thresholdVolume),
+                               threshold_volume=rocks.granite_dpgk(**damage_options(a, "benz-asphaug")).thresholdVolume,
                                damage_strain=a.damage_strain,
                                threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
                                edges=a.edges, edge_set=a.edge_set, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
@@ -389,22 +388,24 @@ def main(argv=None):
                                        uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
     if "damage" in parts:
         results = []
-        for law in [int(v) for v in a.laws.split(",")]:
+        for law in a.laws.split(","):
+            if law not in CHOICES["growthLaw"]:
+                ap.error(f"--laws: {law!r} is not one of {CHOICES['growthLaw']}")
             r = run_damage(a, law, a.out)
             results.append(r)
             particles = max(particles, r["particles"])
             table = [dict(t_s=t, left=interp_da(r["rows"], t)[0], right=interp_da(r["rows"], t)[1])
                      for t in [0.05, 0.1, 0.2, 0.3, 0.4] if t <= a.end_time + 1e-9]
-            summary[f"damage_law{law}"] = dict(crack_extension_cells=table, plastic_particles=r["plastic"],
+            summary[f"damage_{law}"] = dict(crack_extension_cells=table, plastic_particles=r["plastic"],
                                                plastic_particles_not_cracked=r["plastic_intact"],
                                                wall_time_s=r["wall"], steps=r["steps"], ramp_time_s=r["ramp"],
                                                spacing_m=r["h"], particles=r["particles"])
             if a.end_time >= PAPER_DA[-1][0] - 1e-9:
-                summary[f"damage_law{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
+                summary[f"damage_{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
             print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
                   + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
         plot_da(results, a.out)
-        first = summary[f"damage_law{results[0]['law']}"]
+        first = summary[f"damage_{results[0]['law']}"]
         summary["default_law"] = results[0]["law"]
         summary["crack_extension_cells"] = first["crack_extension_cells"]
         summary["plastic_particles"] = first["plastic_particles"]

@@ -26,15 +26,15 @@ TIMES = [0.05, 0.1, 0.2, 0.3, 0.4]
 def load(path, law):
     with open(os.path.join(path, "summary.json")) as f:
         summ = json.load(f)
-    rows = np.loadtxt(os.path.join(path, f"crack_extension_law{law}.csv"), delimiter=",", skiprows=1, ndmin=2)
-    h = summ[f"damage_law{law}"]["spacing_m"]
+    rows = np.loadtxt(os.path.join(path, f"crack_extension_{law}.csv"), delimiter=",", skiprows=1, ndmin=2)
+    h = summ[f"damage_{law}"]["spacing_m"]
     return summ, rows, h
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True, help="output path without extension (CSV and PNG are written)")
-    ap.add_argument("--law", type=int, default=0, help="growth law of the CSV to read (default 0)")
+    ap.add_argument("--law", default="benz-asphaug", help="growth law (DpGkMat.growthLaw) of the CSV to read")
     ap.add_argument("--title", default="line crack, Δa(t) against the paper's Fig. 9")
     ap.add_argument("runs", nargs="+", help="label=directory of a penny_crack.py damage run")
     a = ap.parse_args(argv)
@@ -53,7 +53,7 @@ def main(argv=None):
         ok = [d for d in dev if np.isfinite(d)]
         rms = float(np.sqrt(np.mean(np.square(ok)))) if ok else float("nan")
         mx = float(np.max(np.abs(ok))) if ok else float("nan")
-        wall = summ[f"damage_law{a.law}"]["wall_time_s"]
+        wall = summ[f"damage_{a.law}"]["wall_time_s"]
         table.append([label, h, summ["config"].get("ramp_time_s"), *da, init, rms, mx, wall])
         curves.append((label, rows[:, 0], 0.5 * (rows[:, 2] + rows[:, 3]) * cells))
     header = ["run", "spacing_m", "ramp_s"] + [f"da_t{t}_cells002" for t in TIMES] + [

@@ -177,7 +177,7 @@ def penny(R):
                          ("paper", lambda r: paper.get(round(r["t_s"], 3)))]))
     R.w(f"Wall time {fmt(s.get('wall_time_s'))} s, {fmt(s.get('particles'))} particles.", "")
     if dmg is not None:
-        R.figures("penny_crack_damage", ["crack_extension.png", "damage_law0_t0.40s.png"])
+        R.figures("penny_crack_damage", ["crack_extension.png", "damage_benz-asphaug_t0.40s.png"])
 
 
 def stability(R):

@@ -29,7 +29,7 @@ def test_dpgk_parameters():
                 cohesion=1e6, weibullK=1e30, weibullM=8)
     ym.DpGkMat(**base)
     for k, v in [("frictionAngle", math.pi), ("dilatancyAngle", 1.0), ("cohesion", -1.0), ("weibullM", 0.0),
-                 ("critPlasticStrain", 0.0), ("growthLaw", 3)]:
+                 ("critPlasticStrain", 0.0), ("growthLaw", 3), ("growthLaw", "fast")]:
         with pytest.raises(ValueError, match=k):
             ym.DpGkMat(**dict(base, **{k: v}))
     with pytest.raises(TypeError, match="unknown parameter"):
@@ -275,14 +275,14 @@ def test_damage_state_out_of_range_through_views_refused(field, value, msg):
 def test_damage_threshold_outside_unit_interval_refused():
     """ε_D⁰ = (V k)^(−1/m) (Eq. 37) must lie in (0, 1): V·k < 1 means fewer than one flaw per particle and
     a threshold strain above 100 % (damage can never start) — it was accepted silently."""
-    m = ym.rocks.granite_dpgk(weibullK=1e3, thresholdVolume=0)   # literal V: V k = (0.05 m)²·1 m · 1e3 = 2.5
+    m = ym.rocks.granite_dpgk(weibullK=1e3, thresholdVolume="particle")   # literal V: V k = (0.05 m)²·1 m · 1e3 = 2.5
     assert 0 < m.activationStrain(2.5e-3) < 1
     s = _solver()
     ym.add_region(s, m, (0, 0), (1, 1))                # accepted: ε_D⁰ = 2.5^(−1/7.5) ≈ 0.885
     assert s.view("eps0")[0] == pytest.approx(2.5 ** (-1 / 7.5), rel=1e-12)
-    low = ym.rocks.granite_dpgk(weibullK=100.0, thresholdVolume=0)   # V k = 0.25: ε_D⁰ = 0.25^(−1/7.5) ≈ 1.2
+    low = ym.rocks.granite_dpgk(weibullK=100.0, thresholdVolume="particle")   # V k = 0.25: ε_D⁰ = 0.25^(−1/7.5) ≈ 1.2
     with pytest.raises(ValueError, match=r"damage threshold eps0 = .* = 1.2.* for V = 0.0025 m³ \(particle volume 0.0025 m³, "
-                                         r"thresholdVolume = 0\) is outside the allowed range \(0, 1\) .*V·weibullK = 0.25 must exceed 1"):
+                                         r"thresholdVolume = 'particle'\) is outside the allowed range \(0, 1\) .*V·weibullK = 0.25 must exceed 1"):
         s.setMaterial(low)
     assert s.dpgkParameters().weibullK == 1e3          # refused before anything changed
     s2 = _solver()

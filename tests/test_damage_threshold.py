@@ -30,11 +30,11 @@ def block(spacing, size=0.2, dim=2, **mat):
 
 @pytest.mark.parametrize("spacing", [0.04, 0.02])
 def test_threshold_volume_readings_give_eq37(spacing):
-    """V = particle area × 1 m (literal), dp³ (default) and l²·dp: every particle's ε_D⁰ is (Vk)^(−1/m)."""
+    """V = particle area × 1 m (literal, default), dp³ and l²·dp: every particle's ε_D⁰ is (Vk)^(−1/m)."""
     dp = spacing / 2
     s, _ = block(spacing)
-    assert s.view("eps0") == pytest.approx(np.full(s.numParticles, eq37(dp ** 3)), rel=1e-12)   # default
-    for reading, V in [(0, dp * dp * 1.0), (1, dp ** 3), (2, spacing ** 2 * dp)]:
+    assert s.view("eps0") == pytest.approx(np.full(s.numParticles, eq37(dp * dp * 1.0)), rel=1e-12)   # default
+    for reading, V in [("particle", dp * dp * 1.0), ("cube", dp ** 3), ("cell", spacing ** 2 * dp)]:
         s, _ = block(spacing, thresholdVolume=reading)
         eps0 = s.view("eps0")
         assert eps0 == pytest.approx(np.full(s.numParticles, eq37(V)), rel=1e-12), reading
@@ -45,14 +45,27 @@ def test_threshold_volume_readings_give_eq37(spacing):
         assert eq37(dp * dp) == pytest.approx(4.540e-4, rel=1e-3)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_default_threshold_volume_is_the_particle_volume(dim):
+    """Issue 18: by default V of Eq. 37 is the particle's own volume, as in the reference code of the paper's
+    DP–GK model (Graphyt: vol = mass/density, emin = pow(vol·k, −1/m); 2D volume psep² per unit depth).
+    V is taken here from each particle's mass and the rock density, not from the solver's volume arrays."""
+    s, dp = block(0.04, size=0.16, dim=dim)
+    assert s.dpgkParameters().thresholdVolume == "particle"
+    V = s.view("mass") / rocks.GRANITE["density"]                    # [m³]; 2D: area × 1 m
+    assert V == pytest.approx(np.full(s.numParticles, dp ** dim), rel=1e-12)
+    assert s.view("eps0") == pytest.approx((V * K) ** (-1.0 / M_W), rel=1e-12)
+    assert s.view("eps0")[0] == pytest.approx({2: 3.774e-4, 3: 6.358e-4}[dim], rel=1e-3)   # by hand: (dp^D k)^(−1/m), dp = 0.02 m
+
+
 def test_threshold_volume_in_3d_is_the_particle_volume():
-    s, dp = block(0.05, size=0.1, dim=3, thresholdVolume=0)
+    s, dp = block(0.05, size=0.1, dim=3, thresholdVolume="particle")
     assert s.view("eps0") == pytest.approx(np.full(s.numParticles, eq37(dp ** 3)), rel=1e-12)
-    s, dp = block(0.05, size=0.1, dim=3, thresholdVolume=1)
+    s, dp = block(0.05, size=0.1, dim=3, thresholdVolume="cube")
     assert s.view("eps0") == pytest.approx(np.full(s.numParticles, eq37(dp ** 3)), rel=1e-12)
 
 
-@pytest.mark.parametrize("reading", [0, 1, 2])
+@pytest.mark.parametrize("reading", ["particle", "cube", "cell"])
 def test_regularised_threshold_scales_with_root_of_cell_size(reading):
     """thresholdCell = l_ref: on the l_ref grid ε_D⁰ is Eq. 37's; on any grid ε_D⁰·√l is the same."""
     lref = 0.02
@@ -63,7 +76,7 @@ def test_regularised_threshold_scales_with_root_of_cell_size(reading):
         assert np.ptp(e) == 0
         vals[spacing] = e[0]
     dp = lref / 2
-    V = {0: dp * dp, 1: dp ** 3, 2: lref ** 2 * dp}[reading]
+    V = {"particle": dp * dp, "cube": dp ** 3, "cell": lref ** 2 * dp}[reading]
     assert vals[0.02] == pytest.approx(eq37(V), rel=1e-12)
     for spacing, e in vals.items():
         assert e * math.sqrt(spacing) == pytest.approx(eq37(V) * math.sqrt(lref), rel=1e-12)
@@ -85,7 +98,7 @@ def test_eq36_strain_measures():
     assert printed / principal == pytest.approx(2 * (LAM + G) / PMOD)      # 1/(1 − ν) with ν = λ/(2(λ + G))
     assert printed / principal == pytest.approx(1 / (1 - NU))
     de = [e, e, 0.0, 0.0]
-    for measure, eb in [(0, printed), (1, principal)]:
+    for measure, eb in [("uniaxial", printed), ("principal", principal)]:
         _, _, _, d_below = upd([0, 0, 0, 0], de, eps0=eb * (1 + 1e-9), damageStrain=measure, plasticity=False)
         _, _, _, d_above = upd([0, 0, 0, 0], de, eps0=eb * (1 - 1e-9), damageStrain=measure, plasticity=False)
         assert d_below == 0.0 and d_above > 0.0, measure
@@ -125,7 +138,7 @@ def test_flaw_population_statistics():
     spacing = 0.01
     s, dp = block(spacing, size=0.7, flawCount=16, flawSeed=11)     # 19 600 particles
     n = s.numParticles
-    V = dp ** 3                       # default reading (thresholdVolume = 1)
+    V = dp * dp * 1.0                 # default reading (thresholdVolume = "particle": area × 1 m)
     scale = eq37(V)
     eps0 = s.view("eps0")
     for lam in (0.02, 0.1, 0.5, 1.0, 2.0):
@@ -155,7 +168,7 @@ def test_flaws_cap_damage_by_activated_fraction():
     mat = rocks.granite_dpgk(flawCount=8, flawSeed=5, plasticity=False)
     vol0, l = 1e-4, 0.02
     scale = ym.dpgkThresholdScale(mat, vol0, l, 2)
-    assert scale == pytest.approx(eq37(0.01 ** 3), rel=1e-12)      # default reading: dp³, dp = √(1e-4 m²)
+    assert scale == pytest.approx(eq37(vol0), rel=1e-12)           # default reading: V = vol0 (area × 1 m)
     thr = ym.dpgkFlawThresholds(mat, scale, 42, 8)
     eb = 0.5 * (thr[2] + thr[3])                       # between the 3rd and 4th flaw
     e = eb * PMOD / (LAM + 2 * G)                      # uniaxial strain: ε̄ (Eq. 36) = e
@@ -175,6 +188,8 @@ def test_flaws_cap_damage_by_activated_fraction():
 
 def test_bad_damage_options_are_refused():
     for kw, word in [(dict(thresholdVolume=3), "thresholdVolume"), (dict(damageStrain=2), "damageStrain"),
+                     (dict(thresholdVolume=1), r"thresholdVolume must be one of 'particle', 'cube' or 'cell'"),
+                     (dict(damageStrain="eq36"), r"damageStrain must be one of 'uniaxial' or 'principal'"),
                      (dict(thresholdCell=-0.01), "thresholdCell"), (dict(flawCount=-1), "flawCount"),
                      (dict(flawSeed=-1), "flawSeed")]:
         with pytest.raises(ValueError, match=word):

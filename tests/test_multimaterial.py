@@ -82,7 +82,7 @@ def test_regions_keep_their_own_material_and_damage_thresholds():
     # the rock keeps its parameters and its particles their Eq. 37 thresholds ε_D⁰ = (V k)^(−1/m)
     assert s.material(0).toDict() == rock.toDict()
     eps0 = s.view("eps0")[np.argsort(s.view("id"))]
-    v = (0.01 / 2) ** 3                                    # V = dp³ (default thresholdVolume = 1)
+    v = (0.01 / 2) ** 2 * 1.0                              # V = particle area × 1 m (default thresholdVolume = "particle")
     assert np.allclose(eps0[ids_rock], (v * rock.weibullK) ** (-1 / rock.weibullM), rtol=1e-12)
     assert np.array_equal(eps0[ids_rock], eps0_before[ids_rock])
     assert np.all(eps0[ids_grout] == 0)
@@ -113,7 +113,7 @@ def test_material_view_is_read_only_and_set_particle_material_gives_the_new_thre
     g, r = slot[ids_grout[:5]], slot[ids_rock[:3]]
     assert np.all(s.view("eps0")[g] == 0)
     s.setParticleMaterial(g, 0)                            # grout → rock
-    v = (0.01 / 2) ** 3                                    # V = dp³ (default thresholdVolume = 1)
+    v = (0.01 / 2) ** 2 * 1.0                              # V = particle area × 1 m (default thresholdVolume = "particle")
     assert np.all(s.view("material")[g] == 0)
     assert np.allclose(s.view("eps0")[g], (v * rock.weibullK) ** (-1 / rock.weibullM), rtol=1e-12)
     s.setParticleMaterial(r, 1)                            # rock → grout: no damage threshold

@@ -9,7 +9,7 @@ import yade_mpm as ym
 
 ROCK = ym.rocks.GRANITE_DPGK                                       # the paper's Sec. 3.2 rock
 UNIT = re.compile(r"\[[^\]]+\]")                                    # "[Pa]", "[-]", "[kg/m³]"
-RANGE = re.compile(r"range [\[(][^,]+, [^\])]+[\])]|True or False")  # "range (0, inf)", bools
+RANGE = re.compile(r"range [\[(][^,]+, [^\])]+[\])]|True or False|one of '")  # "range (0, inf)", bools, named options
 
 
 def _public_attributes(cls):
@@ -53,12 +53,12 @@ def test_declared_ranges_are_enforced_at_the_ends():
 
 
 def test_round_trip_and_alias():
-    m = ym.DpGkMat(**dict(ROCK, crackSpeed=1234.5, growthLaw=1, residualCohesion=0.25))
+    m = ym.DpGkMat(**dict(ROCK, crackSpeed=1234.5, growthLaw="as-printed", residualCohesion=0.25))
     d = m.toDict()
     assert d["dilationAngle"] == ROCK["dilationAngle"] and "dilatancyAngle" not in d
     back = ym.DpGkMat.fromDict(json.loads(json.dumps(d)))     # through JSON, as a checkpoint is
     assert back.toDict() == d
-    assert back.crackSpeed == 1234.5 and back.growthLaw == 1 and back.residualCohesion == 0.25
+    assert back.crackSpeed == 1234.5 and back.growthLaw == "as-printed" and back.residualCohesion == 0.25
     # alias: the paper's name writes the same field
     a = ym.DpGkMat(**{k: v for k, v in ROCK.items() if k != "dilationAngle"}, dilatancyAngle=0.1)
     assert a.dilationAngle == 0.1 and a.dilatancyAngle == 0.1
@@ -78,7 +78,9 @@ def test_round_trip_and_alias():
     ("young", None, r"young .*required"),
     ("poisson", [0.2], r"DpGkMat.poisson must be a number"),
     ("plasticity", 2, r"DpGkMat.plasticity must be True or False"),
-    ("growthLaw", 0.5, r"DpGkMat.growthLaw must be an integer in \[0, 1\]"),
+    ("growthLaw", 0.5, r"DpGkMat.growthLaw must be one of 'benz-asphaug' or 'as-printed' \(got float 0.5\)"),
+    ("growthLaw", 1, r"DpGkMat.growthLaw must be one of .*integer codes were replaced by these words"),
+    ("thresholdVolume", "area", r"DpGkMat.thresholdVolume must be one of 'particle', 'cube' or 'cell' \(got str area\)"),
     ("weibullM", 1e-300, r"weibullM = 1e-300 \[-\] is outside the allowed range \[1, 50\]"),
     ("frictionAngle", math.nan, r"frictionAngle = nan \[rad\] is outside"),
     ("cohesion", math.inf, r"cohesion = inf \[Pa\] is outside"),

@@ -43,7 +43,7 @@ from . import _core
 from .engine import MpmEngine, _registry as _engines
 from .scene import SYM_NAMES, dim_of
 
-FORMAT = 2   # 2: solver settings as Solver.settings() in the header (1: a hand-written list)
+FORMAT = 3   # 3: named material options as words; 2: solver settings as Solver.settings() in the header (1: a hand-written list)
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
 
