@@ -132,7 +132,7 @@ def test_old_format_and_other_settings_are_refused(saved, tmp_path):
     before = _state(s)
     old = tmp_path / "old.ckpt"                     # format 1: the settings as a hand-written list
     _rewrite(saved, old, edit_header=lambda h: h.update(format=1))
-    with pytest.raises(checkpoint.CheckpointError, match=r"format version 1, this yade_mpm reads version 2 only .*rerun from the start"):
+    with pytest.raises(checkpoint.CheckpointError, match=rf"format version 1, this yade_mpm reads version {checkpoint.FORMAT} only .*rerun from the start"):
         checkpoint.load(old)
     other = tmp_path / "other.ckpt"
     _rewrite(saved, other, edit_header=lambda h: h["settings"]["mpmCk"].update(oldSetting=1.0))
