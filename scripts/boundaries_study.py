@@ -20,7 +20,8 @@ import numpy as np
 
 import yade_mpm as ym
 import yade_mpm.output as out
-from yade_mpm import cases, kirsch
+from yade_mpm import cases
+from yade_mpm.validation import kirsch
 
 
 def uniform_block(dim, axis, side, kind, h=0.1, sigma=-40e6, steps=300):

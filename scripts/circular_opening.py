@@ -33,7 +33,7 @@ import numpy as np
 
 import yade_mpm as ym
 import yade_mpm.output as out
-from yade_mpm import kirsch
+from yade_mpm.validation import kirsch
 
 from yade_mpm import cases, rocks, runner
 from yade_mpm.cases import OPENING_CENTER as CENTER, OPENING_RADIUS as RADIUS, OPENING_SXX as SXX_FAR, OPENING_SYY as SYY_FAR

@@ -8,7 +8,7 @@
      excluded, grid spacing --mpm-spacing, ppc = 2; end caps: no tensile damage within 3 cells of the base
      and the platen (--capped-ends; without them the layer under the penalty contact cracks first).
    - JCFpm: between two frictionless YADE walls, the top one closing as the MPM platen; a layer of bonded spheres, centres at z = 0, motion restricted to the plane
-     (yade_mpm.bonded; plane strain: ε_zz = 0 exactly), mean radius --dem-radius, thickness mapping
+     (yade_mpm.validation.bonded; plane strain: ε_zz = 0 exactly), mean radius --dem-radius, thickness mapping
      t = 2 r̄ (stress = platen force / (W t)).
    "E" on both sides is the apparent plane-strain modulus Δσ_yy/Δε_yy of the test (slope of the first
    rise between 25 % and 50 % of the peak, platen displacement / specimen height); for the elastic MPM
@@ -44,7 +44,8 @@ import time
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import bonded, cases, rocks
+from yade_mpm import cases, rocks
+from yade_mpm.validation import bonded
 from yade_mpm import output as out
 
 MPa, GPa = 1e6, 1e9

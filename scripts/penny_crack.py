@@ -33,15 +33,14 @@ import numpy as np
 
 import yade_mpm as ym
 import yade_mpm.output as out
-from yade_mpm import sneddon
+from yade_mpm.validation import sneddon
+from yade_mpm.validation.line_crack import PAPER_CELL, PAPER_DA, crack_extension, interp_da, paper_comparison
 
 from yade_mpm import cases, rocks, runner
 
 ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
 HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
 PAPER_RAMP = 0.5                       # s
-PAPER_DA = [(0.1, 7), (0.2, 22), (0.4, 72)]   # Fig. 9: (t [s], Δa [cells of 0.02 m])
-PAPER_CELL = 0.02                      # m
 SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
 
 
@@ -112,23 +111,6 @@ def run_elastic(size, h, P, args):
     return dict(h=h, size=size, particles=s.numParticles, steps=s.steps, t=s.time, wall=wall,
                 uy_centre_err=uy_centre_err, uy_l2=uy_l2, syy_l2_far=syy_l2, x=x, uy=uy, ua=ua,
                 xs=xu, syy=syy_m, sxx=sxx_m, sa=sa, ke=s.kineticEnergy())
-
-
-def crack_extension(s, geo, band):
-    """Δa [cells of this grid] at the left and right tips: contiguous columns of grid cells beyond the
-    initial tip holding at least one fully damaged (D = 1) particle within |y − yc| < band."""
-    pos, dmg = ym.get(s, "pos"), ym.get(s, "damage")
-    h = geo["h"]
-    broken = (dmg >= 1.0) & (np.abs(pos[:, 1] - geo["yc"]) < band)
-    res = []
-    for side in (-1, 1):
-        d = side * (pos[broken, 0] - geo["xc"]) - HALF_CRACK
-        cols = set(np.floor(d[d >= 0] / h).astype(int).tolist())
-        k = 0
-        while k in cols:
-            k += 1
-        res.append(k)
-    return res
 
 
 def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
@@ -207,28 +189,6 @@ def run_damage(args, law, outdir):
     return dict(law=law, rows=rows, wall=wall, particles=s.numParticles, steps=s.steps, plastic=plastic,
                 plastic_intact=plastic_intact,
                 ramp=ramp, scale=scale, h=h, size=size)
-
-
-def paper_comparison(rows, h):
-    """Δa in cells of the paper's grid (0.02 m) at the paper's times, its deviations from Fig. 9 (RMS and
-    largest, cells), and the initiation time (first record with Δa ≥ 1 cell of this grid at either tip)."""
-    cells = h / PAPER_CELL
-    da = [0.5 * sum(interp_da(rows, t)) * cells for t, _ in PAPER_DA]
-    dev = [d - n for d, (_, n) in zip(da, PAPER_DA)]
-    init = next((r[0] for r in rows if max(r[2], r[3]) >= 1), None)
-    return dict(da_paper_cells=da, deviation_cells=dev, rms_deviation_cells=math.sqrt(sum(x * x for x in dev) / len(dev)),
-                max_abs_deviation_cells=max(abs(x) for x in dev), initiation_t_paper_s=init,
-                symmetric=all(abs(r[2] - r[3]) <= 1 for r in rows),
-                monotonic=all(b[2] >= a[2] and b[3] >= a[3] for a, b in zip(rows, rows[1:])))
-
-
-def interp_da(rows, t):
-    """Δa (left, right) of the last record at or before paper time t."""
-    best = None
-    for r in rows:
-        if r[0] <= t + 1e-9:
-            best = r
-    return (best[2], best[3]) if best else (0, 0)
 
 
 def plot_elastic(e, outdir, P):

@@ -16,9 +16,8 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import penny_crack as pc  # noqa: E402
-import yade_mpm.output as out  # noqa: E402
+import yade_mpm.output as out
+from yade_mpm.validation import line_crack as pc   # Fig. 9 points and Δa(t) reading, shared with penny_crack.py
 
 TIMES = [0.05, 0.1, 0.2, 0.3, 0.4]
 

@@ -2,7 +2,7 @@
 """Stability suite (issue 3, part 3): small scenes that push the explicit WLS-MPM step to its limits.
 
 The scenes and the per-step checks (finite state, energy bound, Δt within the stable limit, clear
-stop messages) live in yade_mpm.stability; this script runs them and writes the table and plots.
+stop messages) live in yade_mpm.validation.stability; this script runs them and writes the table and plots.
 
 Usage: /usr/bin/python3 scripts/stability.py --out DIR [--fast] [--cases a,b]
 Writes DIR/summary.json ("cases": list of {case, outcome, nan_seen, max_energy_ratio, steps,
@@ -14,7 +14,7 @@ import sys
 
 import numpy as np
 import yade_mpm as ym
-from yade_mpm.stability import CASES, ENERGY_FLOOR, ENERGY_TOL, run_case
+from yade_mpm.validation.stability import CASES, ENERGY_FLOOR, ENERGY_TOL, run_case
 
 
 def print_table(rows, stream=sys.stdout):

@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import cases, output, runner
+from yade_mpm import analysis, cases, output, runner
 
 DEFAULT_SPACING = 2.0e-3       # coarse default grid [m]: the whole set in < 15 min on 2 idle cores
 END_TIME = 0.014               # simulated loading time [s] (1.4 mm of platen travel); runs stop earlier once softened
@@ -95,10 +95,8 @@ def one_run(variant, mu, c_mpa, a):
         curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
 
     def snapshot(solver):
-        o = ym.id_order(solver)
-        snaps[f"{solver.time:.6e}"] = np.column_stack([ym.get(solver, "pos", o), ym.get(solver, "damage", o),
-                                                       ym.get(solver, "plastic_strain", o),
-                                                       ym.get(solver, "max_principal_stress", o)])
+        f = ym.fields(solver, ["pos", "damage", "plastic_strain", "max_principal_stress"])
+        snaps[f"{solver.time:.6e}"] = np.column_stack([f["pos"], f["damage"], f["plastic_strain"], f["max_principal_stress"]])
 
     def softened(solver):       # stop after the peak: stress below 60 % of a peak of ≥ 5 MPa, 20 % later than it
         if solver.steps % 50:
@@ -107,6 +105,7 @@ def one_run(variant, mu, c_mpa, a):
         k = int(np.argmax(st))
         return st[k] > 5e6 and st[-1] < 0.6 * st[k] and solver.time > 1.2 * curve[k][0]
     series = output.VtuSeries(d)
+    lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
     snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})
     t0 = time.time()
     res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
@@ -124,12 +123,17 @@ def one_run(variant, mu, c_mpa, a):
     if sc["filler"] is not None:
         p = O.bodies[sc["filler"]].state
         filler_disp = dict(dx_m=float(p.displ()[0]), dy_m=float(p.displ()[1]), rotation_rad=float(p.rot()[2]))
+    fl = sc["flaw"]                                # cracks and shear bands at the end (yade_mpm.analysis)
+    rep = analysis.crack_report(ym.fields(s), lattice, fl and fl["polygon"], analysis.softening_end(s),
+                                flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * a.spacing)
+    cracks = [{k: c[k] for k in ("length", "angle_deg", "centroid")} for c in rep["cracks"][:4] + rep["bands"][:4]]
     entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
                  softened=bool(res.reason == "stop"), spacing_m=a.spacing, filler_motion=filler_disp,
-                 damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))
+                 damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)),
+                 cracks_end=cracks[:len(rep["cracks"][:4])], shear_bands_end=cracks[len(rep["cracks"][:4]):])
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "

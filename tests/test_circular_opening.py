@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm import cases, kirsch, rocks
+from yade_mpm import cases, rocks
+from yade_mpm.validation import kirsch
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "scripts", "circular_opening.py")

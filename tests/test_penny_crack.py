@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm import sneddon
+from yade_mpm.validation import sneddon
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

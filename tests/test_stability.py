@@ -1,4 +1,4 @@
-"""Stability suite (yade_mpm.stability), fast versions (coarse grids) of scripts/stability.py: every case finishes, or is
+"""Stability suite (yade_mpm.validation.stability), fast versions (coarse grids) of scripts/stability.py: every case finishes, or is
 stopped by the solver with a message naming step, particle id and quantity; no NaN; KE + U_el never
 above the input energy by more than the tolerance; Δt never above the stable limit."""
 import math
@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm import stability as st
+from yade_mpm.validation import stability as st
 
 
 @pytest.fixture(scope="module", autouse=True)

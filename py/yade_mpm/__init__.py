@@ -14,8 +14,9 @@ _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 from ._core import (Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D,
                     dpgkFlawThresholds, dpgkThresholdScale)
 from .materials import ElasticMat, DpGkMat
-from .scene import (check_setting, make_solver, add_region, views, get, id_order, set_initial_stress, boundary_particles, apply_traction,
-                    apply_face_traction, consistent_row_weights, SYM_NAMES)
+from .fields import get, fields, FIELDS, id_order, views, SYM_NAMES
+from .scene import (check_setting, make_solver, add_region, set_initial_stress, boundary_particles, apply_traction,
+                    apply_face_traction, consistent_row_weights)
 from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
 from .bodies import RigidBodies, CONTACT_DEFAULTS

@@ -1,10 +1,24 @@
-"""Crack analytics on 2D particle results, for the questions a rock engineer asks of a failure run:
-how symmetric is the damage, where are the shear bands and how are they inclined, which rock has
-spalled off an opening (area and mass).
+"""Crack analytics on 2D particle results, for the questions a rock engineer asks of a failure run on
+any scene: which rock has spalled off an opening (area, mass), where the shear bands are and how they
+are inclined, how long the tensile cracks are and how they are oriented, how far the failed zone
+grown from a point (a flaw toe) reaches, how symmetric the damage is.
+
+    import yade_mpm as ym
+    from yade_mpm import analysis
+    lat = analysis.Lattice(ym.get(s, "pos"), dp=s.spacing / ppc)      # at the start (initial positions)
+    ...                                                                # run
+    r = analysis.crack_report(ym.fields(s), lat, opening=holes, soft_end=analysis.softening_end(s),
+                              axis_x=0.075, point=flaw_toe)
+    r["spalled"]["area"], r["bands"][0]["angle_deg"], r["cracks"][0]["length"], r["symmetry_damage"]
+
+The pieces: ``spalled``, ``shear_bands`` / ``bands``, ``cracks``, ``zone_from`` / ``clusters_touching``,
+``mirror_symmetry``, ``opening_surface``, ``opening_distance``, ``distance_to_segment``, ``failed``,
+``softening_end``, ``region_test`` (an opening or a region of interest as shapes or a function).
 
 The particles of a scene built with ``add_region`` sit on a regular lattice of spacing dp = l/ppc
 in the initial configuration; the functions here work on that lattice (neighbours never change),
-with fields given per particle in id order and the initial positions ``x0`` (id order).
+with fields given per particle in id order (``ym.get`` / ``ym.fields``) and the initial positions
+``x0`` (id order).
 """
 import numpy as np
 
@@ -21,6 +35,7 @@ class Lattice:
         if not dp > 0:
             raise ValueError(f"dp = {dp} m must be > 0")
         self.dp = float(dp)
+        self.x0 = x0
         self.lo = x0.min(axis=0) - 0.5 * dp if origin is None else np.asarray(origin, float)   # lower-left corner [m]
         ij = np.rint((x0 - self.lo) / dp - 0.5).astype(np.int64)
         if ij.min() < 0:
@@ -112,8 +127,9 @@ def _opening_sites(lattice, in_opening):
 
 
 def opening_surface(lattice, in_opening):
-    """Per particle: True on the surface of the opening (a 4-neighbour lattice site inside it)."""
-    return _opening_sites(lattice, in_opening)[1][lattice.i, lattice.j]
+    """Per particle: True on the surface of the opening (a 4-neighbour lattice site inside it);
+    in_opening: a shape, a list of shapes or a callable (``region_test``)."""
+    return _opening_sites(lattice, region_test(in_opening, "opening"))[1][lattice.i, lattice.j]
 
 
 def clusters_touching(mask, lattice, seeds):
@@ -130,13 +146,14 @@ def spalled(failed, lattice, in_opening, mass=None):
     """Rock spalled off an opening: the failed particles (fully damaged or softened) connected through
     failed particles (8-neighbours) to the opening surface, plus the intact fragments cut off from the
     main rock body (4-connected components other than the largest) that touch the opening or those
-    failed particles. in_opening(points (M, 2)) -> bool marks lattice sites inside the opening.
+    failed particles. in_opening: the opening as a shape, a list of shapes (e.g. the holes given to
+    ``add_region``) or a callable in_opening(points (M, 2)) -> bool (``region_test``).
     Returns dict(mask (per particle, bool), failed_connected, fragments (particle counts),
     area [m², per metre of thickness in 2D], mass [kg] (sum of `mass` if given))."""
     failed = np.asarray(failed, bool)
     F = lattice.grid(failed, fill=False)
     M = lattice.slot >= 0
-    hole, surface = _opening_sites(lattice, in_opening)
+    hole, surface = _opening_sites(lattice, region_test(in_opening, "opening"))
     lab, n = _label(F, 8)
     touching = np.unique(lab[surface & F])
     touching = touching[touching > 0]
@@ -157,4 +174,134 @@ def spalled(failed, lattice, in_opening, mass=None):
     res = dict(mask=S, failed_connected=int(np.count_nonzero(S_f)), fragments=int(np.count_nonzero(S_d)),
                area=float(np.count_nonzero(S) * lattice.dp ** 2))
     res["mass"] = float(np.sum(np.asarray(mass)[S])) if mass is not None else None
+    return res
+
+
+# ------------------------------------------------------------------------------ regions and masks
+def region_test(region, name="region"):
+    """in_region(points (M, D)) -> bool from a geometry shape (``Circle``, ``Box``, ``Polygon``: anything
+    with ``contains``), a list of shapes (their union) or a callable; ValueError otherwise."""
+    if hasattr(region, "contains"):
+        region = [region]
+    if isinstance(region, (list, tuple)):
+        if not region or not all(callable(getattr(g, "contains", None)) for g in region):
+            raise ValueError(f"{name} must be a shape with contains(points) (Circle, Box, Polygon), a non-empty list "
+                             f"of them, or a callable in_region(points) -> bool (got {region!r})")
+        shapes = list(region)
+        return lambda p: np.any([g.contains(np.asarray(p, float)) for g in shapes], axis=0)
+    if callable(region):
+        return region
+    raise ValueError(f"{name} must be a shape (Circle, Box, Polygon), a list of shapes or a callable (got {type(region).__name__})")
+
+
+def softening_end(solver, order=None):
+    """Per particle (id order, or `order`): the accumulated plastic strain ε̄p at which the DP–GK
+    cohesion reaches its floor, (1 − c_r)·ε̄p_crit (Eq. 34); inf for particles of other materials."""
+    from .fields import id_order
+    kinds = solver.materialKinds
+    mats = [solver.material(i) for i in range(solver.numMaterials)]
+    end = np.array([(1 - m.residualCohesion) * m.critPlasticStrain if k == 1 else np.inf for m, k in zip(mats, kinds)])
+    o = id_order(solver) if order is None else order
+    return end[solver.view("material")[o].astype(np.int64)]
+
+
+def failed(damage, plastic_strain, soft_end):
+    """Per particle: failed = fully damaged (D ≥ 1, a tensile crack) or softened (ε̄p ≥ soft_end, a
+    shear crack: the cohesion at its floor, Eq. 34)."""
+    return (np.asarray(damage) >= 1.0) | (np.asarray(plastic_strain) >= soft_end)
+
+
+def distance_to_segment(points, a, b):
+    """Distance [m] of points (N, 2) from the segment a–b (e.g. a flaw's toe and tip)."""
+    p, a, b = np.asarray(points, float), np.asarray(a, float), np.asarray(b, float)
+    u = b - a
+    L = float(np.hypot(*u))
+    if L == 0:
+        return np.hypot(*(p - a).T)
+    s = np.clip((p - a) @ (u / L), 0, L)
+    return np.hypot(*(p - a - s[:, None] * (u / L)).T)
+
+
+def opening_distance(lattice, opening):
+    """Per particle: distance [m] of its lattice site from the nearest site inside the opening
+    (in_opening as for ``spalled``), measured between site centres (Euclidean distance transform)."""
+    from scipy import ndimage
+    hole = _opening_sites(lattice, region_test(opening, "opening"))[0]
+    if not hole.any():
+        return np.full(len(lattice.i), np.inf)
+    d = ndimage.distance_transform_edt(~hole) * lattice.dp
+    return d[lattice.i, lattice.j]
+
+
+# ------------------------------------------------------------------------------ cracks and bands
+def shear_bands(plastic_strain, lattice, zone=None, fraction=0.5, floor=5e-4, min_sites=None):
+    """Shear bands: the elongated clusters (``bands``) of the particles of `zone` (default all) whose
+    plastic strain ε̄p ≥ threshold = max(floor, fraction × the 99th percentile of ε̄p in the zone), i.e.
+    localised plastic strain. Returns (bands, threshold)."""
+    e = np.asarray(plastic_strain, float)
+    zone = np.ones(len(e), bool) if zone is None else np.asarray(zone, bool)
+    ref = float(np.percentile(e[zone], 99)) if zone.any() else 0.0
+    thr = max(floor, fraction * ref)
+    return bands(zone & (e >= thr), lattice, min_sites), thr
+
+
+def cracks(damage, lattice, level=1.0, min_sites=None):
+    """Tensile cracks: the clusters of particles with D ≥ level (default fully damaged), each with its
+    length [m], orientation (angle_deg to the horizontal) and centroid, as ``bands`` (largest first)."""
+    return bands(np.asarray(damage) >= level, lattice, min_sites)
+
+
+def zone_from(point, mask, lattice, x0, radius):
+    """Per particle: the 8-connected clusters of `mask` that start within `radius` [m] of `point` [m]
+    (e.g. the failed zone grown from a flaw toe); the seeds are the mask's particles in that circle."""
+    seeds = np.asarray(mask, bool) & (np.hypot(*(np.asarray(x0, float) - np.asarray(point, float)).T) < radius)
+    return clusters_touching(mask, lattice, seeds)
+
+
+# ------------------------------------------------------------------------------ everything at once
+def crack_report(fields, lattice, opening, soft_end, rock=None, axis_x=None, flaw=None, point=None, band_gap=5e-3,
+                 band_fraction=0.5, band_floor=5e-4, point_radius=4e-3, opening_dist=None):
+    """The crack analytics of one state of a 2D scene with an opening, in one call.
+
+    fields: per-particle arrays in id order with keys damage, plastic_strain and (optional) mass, e.g.
+    ``yade_mpm.fields(solver)``; lattice: ``Lattice`` of the initial positions; opening: the region the
+    rock spalls into (shape, list of shapes, callable; None: none, nothing spalls); soft_end: ε̄p of a shear crack (scalar, or
+    ``softening_end(solver)``); rock: the particles analysed (default all; e.g. not a grout infill);
+    axis_x [m]: mirror axis of the symmetry (None: not computed); flaw: segment (a, b) [m] whose faces
+    slide — no band is looked for within band_gap [m] of it, nor of the opening (opening_dist: per particle
+    distance from the opening [m], default ``opening_distance``); point [m] (e.g. a flaw toe): the failed
+    zone and the plastic band grown from within point_radius [m] of it.
+
+    Returns dict: failed, softened (per particle), spalled (``spalled``), surface (the failed part of
+    the spalled rock: where the opening wall broke), bands, band_threshold (``shear_bands`` of the rock with D < 1 beyond
+    band_gap), cracks (``cracks``), symmetry_damage, symmetry_plastic, damaged_fraction,
+    softened_fraction (of the rock); with point: point_damaged, point_softened (counts within
+    point_radius), point_failed_reach, point_plastic_reach (per particle: the zone grown from the point
+    on the opening surface)."""
+    D, e = np.asarray(fields["damage"], float), np.asarray(fields["plastic_strain"], float)
+    n = len(lattice.i)
+    if D.shape != (n,) or e.shape != (n,):
+        raise ValueError(f"fields damage and plastic_strain must hold one value per lattice particle ({n})")
+    rock = np.ones(n, bool) if rock is None else np.asarray(rock, bool)
+    in_opening = (lambda p: np.zeros(len(p), bool)) if opening is None else region_test(opening, "opening")
+    fail = rock & failed(D, e, soft_end)
+    soft = rock & (e >= soft_end)
+    sp = spalled(fail, lattice, in_opening, fields.get("mass"))
+    dist = opening_distance(lattice, in_opening) if opening_dist is None else np.asarray(opening_dist, float)
+    zone = rock & (D < 1) & (dist > band_gap)
+    if flaw is not None:
+        zone &= distance_to_segment(lattice.x0, *flaw) > band_gap
+    bnd, thr = shear_bands(e, lattice, zone, band_fraction, band_floor)
+    res = dict(failed=fail, softened=soft, spalled=sp, surface=sp["mask"] & fail, bands=bnd, band_threshold=thr,
+               cracks=cracks(np.where(rock, D, 0), lattice),
+               symmetry_damage=None if axis_x is None else mirror_symmetry(np.where(rock, D, 0), lattice, axis_x),
+               symmetry_plastic=None if axis_x is None else mirror_symmetry(np.where(rock, e, 0), lattice, axis_x),
+               damaged_fraction=float(np.mean(D[rock] >= 1)), softened_fraction=float(np.mean(soft[rock])))
+    if point is not None:
+        near = rock & (np.hypot(*(lattice.x0 - np.asarray(point, float)).T) < point_radius)
+        surface = opening_surface(lattice, in_opening)
+        plastic = rock & (e >= thr)
+        res.update(point_damaged=int(np.count_nonzero(near & (D >= 1))), point_softened=int(np.count_nonzero(near & soft)),
+                   point_failed_reach=clusters_touching(fail, lattice, near & fail) & surface,
+                   point_plastic_reach=clusters_touching(plastic, lattice, near & plastic) & surface)
     return res

@@ -25,14 +25,14 @@ scene differs from the one built (grid, particle count, masses, initial volumes,
 YADE bodies and engines). After ``O.load`` the ``MpmEngine`` registry (the PyRunner commands name the
 engines by label) is restored, so ``yade_mpm.engine(label)`` works again.
 
-``Checkpointer`` adds the run-loop side: a checkpoint every N steps or every M wall minutes, and
-SIGINT / SIGTERM turned into "write a last checkpoint and the outputs, then stop cleanly".
+``Checkpointer`` (``yade_mpm.resumable``) adds the run-loop side: a checkpoint every N steps or every M
+wall minutes, and SIGINT / SIGTERM turned into "write a last checkpoint and the outputs, then stop
+cleanly"; ``resumable.ResumableRun`` is a whole run built on it (resume, solver errors, state file).
 """
 import hashlib
 import io
 import json
 import os
-import signal
 import struct
 import sys
 import time
@@ -41,7 +41,7 @@ import numpy as np
 
 from . import _core
 from .engine import MpmEngine, _registry as _engines
-from .scene import SYM_NAMES, dim_of
+from .fields import SYM_NAMES, dim_of
 
 FORMAT = 3   # 3: named material options as words; 2: solver settings as Solver.settings() in the header (1: a hand-written list)
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
@@ -400,93 +400,4 @@ def load(path, solvers=None, yade=None, meta=None):
     return header
 
 
-# ------------------------------------------------------------------------------------- run loop side
-class Checkpointer:
-    """Periodic checkpoints and clean stops for a run loop.
-
-        ck = Checkpointer("out/run.ckpt", every_steps=20000, every_minutes=None)
-        with ck.signals():                     # SIGINT/SIGTERM: ck.stop_requested becomes True
-            while not done:
-                O.run(chunk, True)
-                ck.tick(steps)                 # saves when due
-                if ck.stop_requested:
-                    ck.save(); write_outputs(); break
-
-    every_steps: steps between checkpoints (None = not by steps); every_minutes: wall minutes
-    between checkpoints (None = not by time). save() passes `solvers`, `meta` and `extra()` (a
-    function returning the script's JSON-able state, or None) to ``save``."""
-
-    def __init__(self, path, every_steps=None, every_minutes=None, solvers=None, meta=None, extra=None, verbose=True):
-        if every_steps is not None and not (int(every_steps) == every_steps and every_steps >= 1):
-            raise ValueError(f"every_steps = {every_steps} must be an integer ≥ 1 (or None)")
-        if every_minutes is not None and not (np.isfinite(every_minutes) and every_minutes > 0):
-            raise ValueError(f"every_minutes = {every_minutes} must be > 0 (or None)")
-        self.path, self.every_steps, self.every_minutes = path, every_steps, every_minutes
-        self.solvers, self.meta, self.verbose = solvers, meta, verbose
-        self.extra = extra                        # None or f() -> JSON-able script state saved with each checkpoint
-        self.last_step, self.last_wall = None, time.time()
-        self.stop_requested, self.signal_name = False, None
-        self.saved = 0
-
-    def due(self, step):
-        if self.last_step is None:
-            self.last_step = step
-        if self.every_steps is not None and step - self.last_step >= self.every_steps:
-            return True
-        return self.every_minutes is not None and time.time() - self.last_wall >= 60 * self.every_minutes
-
-    def tick(self, step):
-        """Save if a checkpoint is due at this step. Returns True if one was written."""
-        if self.due(step):
-            self.save(step)
-            return True
-        return False
-
-    def save(self, step=None):
-        nbytes = save(self.path, solvers=self.solvers, meta=self.meta, extra=self.extra() if self.extra else None)
-        self.last_step = step if step is not None else self.last_step
-        self.last_wall = time.time()
-        self.saved += 1
-        if self.verbose:
-            print(f"[checkpoint] {self.path} ({nbytes / 1e6:.1f} MB)" + (f" at step {step}" if step is not None else ""), flush=True)
-
-    def output(self, steps=50):
-        """A ``runner.Output`` that checks every `steps` steps: writes a checkpoint when one is due and
-        ends the run (``runner.STOP``, so the run's at_end outputs are written) after SIGINT/SIGTERM."""
-        from . import runner
-
-        def check(solver):
-            if self.stop_requested:
-                return runner.STOP
-            self.tick(solver.steps)
-            return None
-        return runner.Output(check, steps=steps)
-
-    def signals(self):
-        """Context manager: SIGINT and SIGTERM set `stop_requested` (the loop then saves and stops)
-        instead of killing the process; a second signal stops at once. Handlers restored on exit."""
-        ck = self
-
-        class _Guard:
-            def __enter__(self):
-                self.old = {}
-                for sig in (signal.SIGINT, signal.SIGTERM):
-                    try:
-                        self.old[sig] = signal.signal(sig, self.handler)
-                    except ValueError:            # not the main thread: no signal handling
-                        pass
-                return ck
-
-            def handler(self, signum, frame):
-                if ck.stop_requested:             # second signal: give up the clean stop
-                    raise KeyboardInterrupt
-                ck.stop_requested, ck.signal_name = True, signal.Signals(signum).name
-                print(f"\n[checkpoint] {ck.signal_name}: writing a last checkpoint and the outputs, then stopping "
-                      "(send it again to stop at once)", flush=True)
-
-            def __exit__(self, *exc):
-                for sig, h in self.old.items():
-                    signal.signal(sig, h)
-                return False
-
-        return _Guard()
+from .resumable import Checkpointer  # noqa: E402,F401  (the run-loop side lives with the resumable run)

@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from .scene import SYM_NAMES, dim_of, get, id_order
+from .fields import SYM_NAMES, dim_of, get, id_order
 
 
 def _b64(arr):
@@ -42,8 +42,9 @@ def write_vtu(path, points, point_data):
         f.write('</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n')
 
 
-def particle_fields(solver):
-    """Every particle field, in particle-id order, as a dict ready for write_vtu."""
+def particle_fields(solver, x0=None):
+    """Every particle field, in particle-id order, as a dict ready for write_vtu; with the initial
+    positions x0 (by id) also the displacement."""
     d = dim_of(solver)
     order = id_order(solver)                      # one sort for all fields
 
@@ -53,25 +54,24 @@ def particle_fields(solver):
     pos = field("pos")
     fields = {"id": field("id"), "velocity": field("vel"), "mass": field("mass"),
               "volume": field("volume")}
+    if x0 is not None:
+        fields["displacement"] = pos - x0
     st = field("stress")
     for k, c in enumerate(SYM_NAMES[d]):
         fields[f"stress_{c}"] = st[:, k]
     fields["max_principal_stress"] = field("max_principal_stress")
     fields["max_tensile_principal_stress"] = np.maximum(fields["max_principal_stress"], 0.0)
-    mat_index = field("material").astype(np.int64)
     if solver.numMaterials > 1:
-        fields["material"] = mat_index            # index into solver.material(i)
+        fields["material"] = field("material").astype(np.int64)   # index into solver.material(i)
     if 1 in solver.materialKinds:                 # some material is DP–GK
+        from .analysis import softening_end
         fields["damage"] = field("damage")
         fields["plastic_strain"] = field("plastic_strain")
         fields["cohesion"] = field("cohesion")
         # crack indicators used by the paper's figures: tensile crack = fully damaged particle,
         # shear crack = plastic strain past the softening end (cohesion at its 0.1 c0 floor), per material
-        mats = [solver.material(i) for i in range(solver.numMaterials)]
-        end = np.array([(1 - m.residualCohesion) * m.critPlasticStrain if k == 1 else np.inf
-                        for m, k in zip(mats, solver.materialKinds)])
         fields["tensile_crack"] = (fields["damage"] >= 1.0).astype(np.int64)
-        fields["shear_crack"] = (fields["plastic_strain"] >= end[mat_index]).astype(np.int64)
+        fields["shear_crack"] = (fields["plastic_strain"] >= softening_end(solver, order)).astype(np.int64)
     return pos, fields
 
 
@@ -126,6 +126,16 @@ def write_pvd(path, entries):
     os.replace(tmp, path)
 
 
+def read_pvd(path):
+    """(time [s], file path) entries of an existing .pvd ([] if there is none)."""
+    import re
+    if not os.path.exists(path):
+        return []
+    d = os.path.dirname(path)
+    with open(path) as f:
+        return [(float(t), os.path.join(d, n)) for t, n in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', f.read())]
+
+
 class VtuSeries:
     """A VTU time series of the particles with a .pvd index for ParaView: ``write(solver)`` writes
     DIR/NAME_NNNNNNNN.vtu (the solver step) and rewrites DIR/NAME.pvd, so the index always lists
@@ -133,13 +143,15 @@ class VtuSeries:
     ``runner.run(s, ..., every=[(1e-3, series.write)])``. `fields`: a function solver → (points,
     {name: array}) (default: ``particle_fields``, every particle field)."""
 
-    def __init__(self, directory, name="particles", fields=None):
+    def __init__(self, directory, name="particles", fields=None, resume=False):
+        """resume=True continues the index of an existing DIR/NAME.pvd (a resumed run keeps the files
+        written before its interruption)."""
         if not isinstance(name, str) or not name or os.sep in name:
             raise ValueError(f"name = {name!r} must be a non-empty file name stem")
         self.directory, self.name = directory, name
         self.fields = fields or particle_fields
-        self.entries = []
         self.pvd = os.path.join(directory, f"{name}.pvd")
+        self.entries = read_pvd(self.pvd) if resume else []
 
     def write(self, solver):
         """Write the current state; returns the .vtu path. A second write at the same step replaces
@@ -150,3 +162,100 @@ class VtuSeries:
         self.entries = [e for e in self.entries if e[1] != path] + [(float(solver.time), path)]
         write_pvd(self.pvd, self.entries)
         return path
+
+
+# ------------------------------------------------------------------------------------- curves and figures
+class CurveRecorder:
+    """A load–displacement curve recorded as a runner callback: ``record(solver)`` after every step adds
+    y() to a running mean and appends [time, x, mean y] each time x() passes the next multiple of dx
+    (e.g. the mean platen stress over every 0.01 mm of platen travel). ``state`` (curve, acc) is a
+    JSON-able dict: keep it in a checkpoint's extra state to continue the curve after a resume."""
+
+    def __init__(self, x, y, dx, state=None):
+        if not (callable(x) and callable(y)) or not (np.isfinite(dx) and dx > 0):
+            raise ValueError(f"CurveRecorder needs callables x(), y() and dx > 0 (got dx = {dx!r})")
+        self.x, self.y, self.dx = x, y, float(dx)
+        self.state = state if state is not None else {}
+        self.state.setdefault("curve", [])
+        self.state.setdefault("acc", [0.0, 0])
+
+    def record(self, solver):
+        acc = self.state["acc"]
+        acc[0] += self.y()
+        acc[1] += 1
+        x = self.x()
+        if x >= len(self.state["curve"]) * self.dx - 1e-12:
+            self.state["curve"].append([solver.time, x, acc[0] / acc[1]])
+            self.state["acc"] = [0.0, 0]
+
+
+def sample_curve(x, y, step):
+    """[(x_k, y(x_k))] at x_k = 0, step, 2·step … up to the last x (linear interpolation; x increasing)."""
+    if len(x) == 0:
+        return []
+    n = int(np.floor(x[-1] / step + 1e-9)) + 1
+    return [(round(k * step, 10), float(np.interp(round(k * step, 10), x, y))) for k in range(n)]
+
+
+def field_figure(pos, panels, marker_size, xlim=None, ylim=None, ncols=3, panel_size=(5.0, 5.2), unit="m"):
+    """Particle fields side by side: panels = [(title, values per particle, colormap, limits)], limits
+    (lo, hi), "sym" (symmetric about 0) or None (the data range); pos (N, 2) in `unit`. Axes left
+    over in the last row are switched off (room for text). Returns (figure, list of axes)."""
+    from matplotlib.colors import Normalize
+    plt = pyplot()
+    nrows = -(-len(panels) // ncols)
+    fig, axs = plt.subplots(nrows, ncols, figsize=(panel_size[0] * ncols, panel_size[1] * nrows))
+    axs = list(np.ravel(axs))
+    for ax, (title, v, cmap, lim) in zip(axs, panels):
+        v = np.asarray(v, float)
+        if lim == "sym":
+            m = np.max(np.abs(v)) or 1.0
+            norm = Normalize(-m, m)
+        elif lim is None:
+            norm = Normalize(np.min(v), np.max(v) if np.max(v) > np.min(v) else np.min(v) + 1)
+        else:
+            norm = Normalize(*lim)
+        sc = ax.scatter(pos[:, 0], pos[:, 1], c=v, s=marker_size, cmap=cmap, norm=norm, marker="s", linewidths=0, rasterized=True)
+        ax.set_title(title, fontsize=9)
+        ax.set_aspect("equal")
+        ax.set_xlabel(f"x [{unit}]"), ax.set_ylabel(f"y [{unit}]")
+        if xlim is not None:
+            ax.set_xlim(*xlim)
+        if ylim is not None:
+            ax.set_ylim(*ylim)
+        fig.colorbar(sc, ax=ax, shrink=0.8)
+    for ax in axs[len(panels):]:
+        ax.axis("off")
+    return fig, axs
+
+
+def box_outline(body):
+    """Corners (4, 2) [m] of a YADE Box body's outline in the x–y plane (its current position and
+    orientation), for pictures of 2D scenes."""
+    e, q, c = body.shape.extents, body.state.ori, body.state.pos
+    R = np.array([[q.toRotationMatrix()[i, j] for j in range(2)] for i in range(2)])
+    return np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * [e[0], e[1]] @ R.T + [c[0], c[1]]
+
+
+def scene_figure(x, groups, outlines=(), marker_size=1.0, unit="m", figsize=(4.6, 4.8)):
+    """The scene as built: particles at x (N, 2) [unit] drawn as squares, one colour per group
+    (groups = [(mask, colour, label)], empty groups skipped) and rigid bodies as filled outlines
+    (outlines = [(corners (M, 2) [unit], colour, label)], e.g. ``box_outline``). Returns (figure, axes)."""
+    from matplotlib.patches import Polygon as Patch
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=figsize)
+    for m, color, label in groups:
+        if np.any(m):
+            ax.scatter(x[m, 0], x[m, 1], s=marker_size, c=color, marker="s", linewidths=0, label=label, rasterized=True)
+    for corners, color, label in outlines:
+        ax.add_patch(Patch(corners, closed=True, fc=color, alpha=0.6, label=label))
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x [{unit}]"), ax.set_ylabel(f"y [{unit}]")
+    return fig, ax
+
+
+def save_figure(fig, path, dpi=110):
+    """tight_layout, write `path`, close the figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    pyplot().close(fig)

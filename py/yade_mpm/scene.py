@@ -1,10 +1,9 @@
-"""Building a scene: a solver whose grid covers a region, particles from geometry, in-situ stress,
-surface tractions, and id-ordered copies of particle fields for post-processing."""
+"""Building a scene: a solver whose grid covers a region, particles from geometry, in-situ stress and
+surface tractions (reading particle fields: ``yade_mpm.fields``)."""
 import numpy as np
 from . import _core
+from .fields import SYM_NAMES, dim_of
 from .geometry import _corners, _integer, _number, fill_region
-
-SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz")}
 
 
 def make_solver(lo, hi, spacing, margin=2):
@@ -31,15 +30,6 @@ def check_setting(name, value, option=None):
     except ValueError as e:
         raise ValueError(str(e).replace(f"Solver2D.{name}", option or name)) from None
     return value
-
-
-def dim_of(solver):
-    """2 or 3; ValueError if `solver` is not a Solver2D/Solver3D."""
-    if isinstance(solver, _core.Solver2D):
-        return 2
-    if isinstance(solver, _core.Solver3D):
-        return 3
-    raise ValueError(f"solver must be a Solver2D or Solver3D (got {type(solver).__name__})")
 
 
 GAP_NODES = ("excluded", "shared")
@@ -135,74 +125,6 @@ def material_index(solver, material):
         if type(m) is type(material) and m.toDict() == material.toDict():
             return i
     return solver.addMaterial(material)
-
-
-def views(solver):
-    """Live NumPy views (storage order, no copy) of every allocated particle field, keyed by name:
-    x0.., v0.., sig0.. (xx, yy, zz, xy[, xz, yz]), mass, vol, id, epsP, damage… The storage order
-    changes when particles are re-sorted; `id` tells which particle sits in each slot."""
-    d = dim_of(solver)
-    names = [f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
-    names += ["mass", "vol", "vol0", "id", "material", "epsP", "damage", "eps0", "nFlaw"]
-    out = {}
-    for n in names:
-        try:
-            out[n] = solver.view(n)
-        except ValueError:
-            pass
-    return out
-
-
-def id_order(solver):
-    """Storage slots in particle-id order (valid until the next step re-sorts the particles)."""
-    return _order(solver)
-
-
-def _order(solver):
-    return np.argsort(solver.view("id"), kind="stable")
-
-
-def get(solver, name, order=None):
-    """Copy of a particle field in particle-id order. Names: pos, vel, stress (the stress carried,
-    damaged for DP–GK; components xx, yy, zz, xy[, xz, yz], tension positive, [Pa]), state_stress,
-    max_principal_stress [Pa], damage, plastic_strain (ε̄p of the rock: a fully damaged particle keeps no
-    tension, so an opening crack does not yield), cohesion [Pa], mass, volume, id."""
-    d = dim_of(solver)
-    o = _order(solver) if order is None else order   # pass order=id_order(solver) when reading many fields
-    if name == "pos":
-        return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
-    if name == "vel":
-        return np.column_stack([solver.view(f"v{a}") for a in range(d)])[o]
-    if name == "stress":
-        return solver.effectiveStress()[o]
-    if name == "state_stress":
-        return np.column_stack([solver.view(f"sig{k}") for k in range(len(SYM_NAMES[d]))])[o]
-    if name == "max_principal_stress":
-        return solver.maxPrincipalStress()[o]
-    if name == "damage":
-        return _optional(solver, "damage")[o]
-    if name == "plastic_strain":
-        return _optional(solver, "epsP")[o]
-    if name == "cohesion":
-        if 1 not in solver.materialKinds:
-            raise ValueError("cohesion exists only for the DP–GK material")
-        return solver.cohesion()[o]  # Eq. 34 with each particle's material; NaN for other materials
-    if name == "material":
-        return solver.view("material")[o].copy()
-    if name == "mass":
-        return solver.view("mass")[o].copy()
-    if name == "volume":
-        return solver.view("vol")[o].copy()
-    if name == "id":
-        return solver.view("id")[o].copy()
-    raise ValueError(f"unknown field '{name}'")
-
-
-def _optional(solver, name):
-    try:
-        return solver.view(name)
-    except ValueError:
-        return np.zeros(solver.numParticles)
 
 
 def set_initial_stress(solver, stress):

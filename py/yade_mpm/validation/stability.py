@@ -23,10 +23,11 @@ import time
 
 import numpy as np
 
-from . import rocks, runner
-from ._core import MpmSimulationError
-from .materials import DpGkMat, ElasticMat
-from .scene import SYM_NAMES, add_region, apply_traction, boundary_particles, dim_of, get, make_solver
+from .. import rocks, runner
+from .._core import MpmSimulationError
+from ..materials import DpGkMat, ElasticMat
+from ..fields import SYM_NAMES, dim_of, get
+from ..scene import add_region, apply_traction, boundary_particles, make_solver
 
 # Allowed excess of KE + U_el over the input energy. Explicit (symplectic-Euler-like) integration does
 # not conserve the discrete energy exactly; its oscillation is O(C) of the energy in the highest modes,

@@ -1,16 +1,13 @@
 """YADE's bonded-particle rock model JCFpm (Scholtès & Donzé 2012: ``JCFpmMat``,
 ``Ip2_JCFpmMat_JCFpmMat_JCFpmPhys``, ``Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM``) set up as
 a plane-strain specimen, for side-by-side runs with the MPM (``scripts/compare_bonded.py``).
-
 Plane strain on the DEM side: one layer of spheres with their centres at z = 0, z translation and the
 rotations about x and y blocked (``blockedDOFs = 'zXY'``), i.e. a disc assembly that moves only in
 the xy plane (ε_zz = 0 exactly, as in the 2D MPM). Thickness mapping: the layer stands for a slab of
 thickness t = 2 r̄ (r̄ the mean radius); stresses are forces / (length · t), and the sphere density is
 raised so that the layer's mass equals ρ · area · t (wave speeds and the time step then belong to the
-rock density, not to the 55 % solid fraction of a sphere layer).
-
-Everything here runs inside YADE (``yade -n -x`` or ``/usr/bin/python3`` with YADE importable) and
-resets ``O``.
+rock density, not to the 55 % solid fraction of a sphere layer). Everything here runs inside YADE
+(``yade -n -x`` or ``/usr/bin/python3`` with YADE importable) and resets ``O``.
 """
 import math
 import os
@@ -66,13 +63,10 @@ def disc_packing(lo, hi, r_mean, rel_fuzz=0.3, seed=1, cache_dir=None, fraction=
     grow = math.sqrt(fraction / frac0)
     for axis, pos in ((0, lo[0]), (0, hi[0]), (1, lo[1]), (1, hi[1])):
         O.bodies.append(utils.wall(pos, axis=axis, material=mat))
-    O.engines = [
-        w.ForceResetter(),
-        w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Wall_Aabb()], verletDist=0.1 * r_mean),
-        w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom(), w.Ig2_Wall_Sphere_ScGeom()],
-                          [w.Ip2_FrictMat_FrictMat_FrictPhys()], [w.Law2_ScGeom_FrictPhys_CundallStrack()]),
-        w.NewtonIntegrator(damping=0.7),
-    ]
+    O.engines = [w.ForceResetter(), w.InsertionSortCollider([w.Bo1_Sphere_Aabb(), w.Bo1_Wall_Aabb()], verletDist=0.1 * r_mean),
+                 w.InteractionLoop([w.Ig2_Sphere_Sphere_ScGeom(), w.Ig2_Wall_Sphere_ScGeom()],
+                                   [w.Ip2_FrictMat_FrictMat_FrictPhys()], [w.Law2_ScGeom_FrictPhys_CundallStrack()]),
+                 w.NewtonIntegrator(damping=0.7)]
     O.dt = 0.5 * utils.PWaveTimeStep()
     stages = 30
     for _ in range(stages):
@@ -95,7 +89,7 @@ def overlapping(shape, xy, r):
     """Boolean mask of the discs (centres xy (N, 2), radii r (N,)) that intersect a hole shape
     (yade_mpm.geometry Circle, Box or Polygon): these are removed, so nothing bridges the hole."""
     xy, r = np.asarray(xy, float), np.asarray(r, float)
-    from .geometry import Box, Circle, Polygon
+    from ..geometry import Box, Circle, Polygon
     if isinstance(shape, Circle):
         return np.hypot(*(xy - shape.center[:2]).T) < shape.radius + r
     if isinstance(shape, Box):
@@ -316,7 +310,7 @@ def circular_opening(packing, micro, center, hole_radius, sxx_far, syy_far, dens
     lo = np.min(packing[:, :2] - packing[:, 2:3], axis=0)
     hi = np.max(packing[:, :2] + packing[:, 2:3], axis=0)
     rho_s = density * float(np.prod(hi - lo)) * t / float(np.sum(4.0 / 3.0 * math.pi * packing[:, 2] ** 3))
-    from .geometry import Circle
+    from ..geometry import Circle
     P = packing[~overlapping(Circle(center, hole_radius), packing[:, :2], packing[:, 2])]
     mat = O.materials.append(w.JCFpmMat(young=micro.young, poisson=micro.ks_kn, frictionAngle=math.radians(micro.friction_deg),
                                         tensileStrength=micro.tensile, cohesion=micro.cohesion, density=rho_s))

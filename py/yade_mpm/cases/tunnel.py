@@ -1,0 +1,209 @@
+"""The arch-shaped tunnel of paper Sec. 4 (Fig. 16), Pan et al. (2020b): the specimen, its opening and
+flaw, the full scene with the YADE platen and filler, and the names of the places around the opening
+that the crack analytics (``yade_mpm.analysis``) report."""
+import math
+
+import numpy as np
+
+from .. import rocks
+from ..geometry import Box, Circle, rotated_rectangle
+from ..scene import add_region, make_solver
+from .loading import PLATEN_FRICTION, PLATEN_SPEED, yade_engines, yade_filler, yade_platen
+
+TUNNEL_WIDTH = 0.15         # square specimen side [m]
+TUNNEL_RECT = (0.04, 0.025)  # width × height of the rectangular part [m]
+TUNNEL_RADIUS = 0.02        # semicircular roof radius [m]
+TUNNEL_FLOOR = 0.055        # height of the tunnel floor above the specimen base [m]
+
+
+def arch_tunnel_holes(width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect=TUNNEL_RECT, radius=TUNNEL_RADIUS):
+    """The arch-shaped opening as holes for ``add_region``: a rect[0] × rect[1] rectangle with its floor
+    at y = floor, centred at x = width/2, under a semicircular roof of `radius` centred on the top edge
+    of the rectangle (radius = rect[0]/2 in the paper)."""
+    cx = width / 2
+    w, hgt = rect
+    return [Box((cx - w / 2, floor), (cx + w / 2, floor + hgt)), Circle((cx, floor + hgt), radius)]
+
+
+def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, walls=("left", "right", "bottom"),
+                         holes=()):
+    """The tunnel specimen [0, width]² with the arch opening (and further `holes`), free-slip walls on
+    `walls` (the paper's four sides minus the loaded top, where the caller puts a platen or a traction).
+    material: default ``rocks.pan2020_sandstone()``. Returns the solver."""
+    planes = {"left": (0, -1, 0.0), "right": (0, 1, width), "bottom": (1, -1, 0.0), "top": (1, 1, width)}
+    bad = [w for w in walls if w not in planes]
+    if bad:
+        raise ValueError(f"walls: unknown {bad}; allowed {sorted(planes)}")
+    mat = material or rocks.pan2020_sandstone()
+    s = make_solver((0, 0), (width, width), spacing, margin=2)
+    add_region(s, mat, (0, 0), (width, width), ppc=ppc, holes=list(arch_tunnel_holes(width, floor)) + list(holes))
+    for w in walls:
+        axis, side, pos = planes[w]
+        s.addBoundaryPlane(axis, side, pos, "slip")
+    return s
+
+
+# The flaw of Figs. 16b, c. The paper gives its size (60 mm × 2 mm, "adjacent to the tunnel", on its
+# left) but not its position or angle; they are chosen from the description of Fig. 19 (the flaw
+# hinders the load path from the top to the left waist; stress concentrates at the flaw toe, next to
+# the left spandrel; a crack links the toe to the tunnel corner) — see doc/tunnel.md. One place only:
+FLAW_LENGTH = 0.06                 # [m]
+FLAW_WIDTH = 0.002                 # [m]
+FLAW_ANGLE = math.radians(60.0)    # inclination to the horizontal [rad]; rises to the left, away from the tunnel
+FLAW_TOE_GAP = 0.010               # horizontal rock bridge from the toe (lower end) to the left wall [m]
+FLAW_TOE = (TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - FLAW_TOE_GAP, TUNNEL_FLOOR + TUNNEL_RECT[1])  # at spandrel height [m]
+
+# Loading and contact of Sec. 4 (platen speed and friction, filler χ: cases.loading)
+TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displacement)
+FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
+TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
+TUNNEL_MAX_SPACING = 1.25 * FLAW_WIDTH   # coarsest grid [m]: the flaw still cuts a full row of particles (ppc = 2)
+
+
+
+def tunnel_flaw(toe=FLAW_TOE, length=FLAW_LENGTH, width=FLAW_WIDTH, angle=FLAW_ANGLE):
+    """The flaw as a dict: toe (lower end, centre of the short side) and tip (upper end) [m], centre,
+    unit direction from toe to tip, normal, length, width [m], angle [rad] and the Polygon."""
+    u = np.array([-math.cos(angle), math.sin(angle)])        # from the toe up and to the left
+    toe = np.asarray(toe, float)
+    center = toe + 0.5 * length * u
+    return dict(toe=toe, tip=toe + length * u, center=center, direction=u, normal=np.array([-u[1], u[0]]),
+                length=length, width=width, angle=angle,
+                polygon=rotated_rectangle(center, length, width, math.atan2(u[1], u[0])))
+
+
+def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
+                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, label="mpm"):
+    """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
+    arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
+    DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
+      case "intact"       no flaw,
+           "open_flaw"    the flaw (``tunnel_flaw()``) cut out,
+           "filled_flaw"  the flaw cut out and filled by a free rigid YADE Box (PTS contact, μ = filler_friction),
+           "grout_flaw"   the flaw filled with particles of the elastic `grout` (default ``rocks.cement_grout()``),
+                          bonded to the rock through the shared grid.
+    spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``).
+    O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
+    Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
+    engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
+    axial_stress() -> platen reaction / width [Pa, compression positive],
+    platen_displacement() -> downward platen displacement since the build [m])."""
+    if case not in TUNNEL_CASES:
+        raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
+    if not (isinstance(spacing, (int, float)) and 0 < spacing <= TUNNEL_MAX_SPACING):
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {TUNNEL_MAX_SPACING}] m (the {FLAW_WIDTH * 1e3:g} mm flaw must "
+                         "cut at least one full particle row, particle spacing l/2)")
+    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
+        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    from yade import O
+    from ..bodies import RigidBodies
+
+    W = TUNNEL_WIDTH
+    flaw = tunnel_flaw() if case != "intact" else None
+    rock = material or rocks.pan2020_sandstone()
+    holes = [flaw["polygon"]] if flaw is not None else []
+    s = arch_tunnel_specimen(spacing, rock, ppc, holes=holes)
+    if case == "grout_flaw":
+        add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
+    O.reset()
+    rb = RigidBodies(s)
+    platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction)
+    filler = yade_filler(rb, flaw, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
+    eng = yade_engines(s, rb, label)
+    y0 = O.bodies[platen].state.pos[1]
+
+    def axial_stress():
+        return rb.force(platen)[1] / W             # the rock pushes the platen up: compression positive
+
+    def platen_displacement():
+        return y0 - O.bodies[platen].state.pos[1]
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W,
+                   axial_stress=axial_stress, platen_displacement=platen_displacement)
+
+
+def tunnel_location(point, flaw=None):
+    """Name of the part of the tunnel (or flaw) nearest a point [m]: "floor", "left/right corner"
+    (where the walls meet the floor), "left/right wall" (the waist), "left/right spandrel" (the arch
+    shoulders, more than 30° from the vertical), "crown", "flaw toe", "flaw tip", "flaw face", or
+    "rock away from the opening" (more than 10 mm from the opening and the flaw)."""
+    x, y = float(point[0]), float(point[1])
+    cx, floor = TUNNEL_WIDTH / 2, TUNNEL_FLOOR
+    hw, hr = TUNNEL_RECT[0] / 2, TUNNEL_RECT[1]
+    if flaw is not None:
+        r = np.array([x, y]) - flaw["toe"]
+        s = float(np.clip(r @ flaw["direction"], 0, flaw["length"]))
+        d_flaw = np.linalg.norm(r - s * flaw["direction"])
+        if d_flaw < 0.005:
+            return "flaw toe" if s < 0.2 * flaw["length"] else ("flaw tip" if s > 0.8 * flaw["length"] else "flaw face")
+    # distance to the opening (rectangle ∪ half disc), 0 inside
+    dx = max(abs(x - cx) - hw, 0.0)
+    dy = max(floor - y, y - (floor + hr), 0.0)
+    d_rect = math.hypot(dx, dy)
+    d_arch = max(math.hypot(x - cx, y - (floor + hr)) - TUNNEL_RADIUS, 0.0) if y >= floor + hr else d_rect
+    if min(d_rect, d_arch) > 0.010:
+        return "rock away from the opening"
+    side = "left" if x < cx else "right"
+    if y >= floor + hr - 0.003:
+        theta = math.degrees(math.atan2(abs(x - cx), max(y - (floor + hr), 1e-12)))
+        return "crown" if theta < 30 else f"{side} spandrel"
+    if y < floor + 0.005:
+        return f"{side} corner" if abs(x - cx) > hw - 0.003 else "floor"
+    return f"{side} wall"
+
+
+def tunnel_opening_distance(points, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect=TUNNEL_RECT, radius=TUNNEL_RADIUS):
+    """Distance [m] of points (N, 2) from the arch opening of ``arch_tunnel_holes`` (0 inside)."""
+    p = np.asarray(points, float)
+    cx, hw, top = width / 2, rect[0] / 2, floor + rect[1]
+    dx = np.maximum(np.abs(p[:, 0] - cx) - hw, 0.0)
+    dy = np.maximum(np.maximum(floor - p[:, 1], p[:, 1] - top), 0.0)
+    d_rect = np.hypot(dx, dy)
+    d_arch = np.maximum(np.hypot(p[:, 0] - cx, p[:, 1] - top) - radius, 0.0)
+    return np.minimum(d_rect, d_arch)
+
+
+def tunnel_where(points, flaw=None):
+    """Where a set of points [m] (N, 2) lies: its most common ``tunnel_location``, or "A and B" when a
+    second place holds at least a quarter as many points (damage on both sides); None for no points."""
+    if len(points) == 0:
+        return None
+    names = [tunnel_location(p, flaw) for p in points]
+    uniq, cnt = np.unique(names, return_counts=True)
+    order = np.argsort(-cnt)
+    return " and ".join([str(uniq[k]) for k in order if cnt[k] >= 0.25 * cnt.max()][:2])
+
+
+# crack analytics of the tunnel (doc/tunnel.md)
+BAND_GAP = 5e-3                    # shear bands are looked for beyond this distance from the opening and the flaw [m]
+BAND_FRACTION, BAND_MIN = 0.5, 5e-4  # band particles: ε̄p ≥ max(BAND_MIN, BAND_FRACTION × its 99th percentile there)
+TOE_RADIUS = 4e-3                  # the failed zone "from the flaw toe" starts within this distance of it [m]
+
+
+def tunnel_report(fields, lattice, flaw, soft_end, rock=None):
+    """``analysis.crack_report`` of a tunnel state (fields by id: damage, plastic_strain, mass; lattice of
+    the initial positions; flaw: ``tunnel_flaw()`` or None; soft_end: ε̄p of a shear crack; rock: the
+    particles that are rock, not grout), with the places named (``tunnel_location``). Returns
+    (report, spalled mask): a JSON-able dict with symmetry_damage, symmetry_plastic, damaged_fraction,
+    softened_fraction, spalled_area_mm2, spalled_mass_kg_per_m, spalled_particles, spalled_fragments,
+    spalling_at, band_threshold, bands (each with side and location), cracks, and with a flaw toe_damaged,
+    toe_softened, toe_link_to_opening, toe_plastic_link_to_opening (where the zone from the toe
+    reaches the opening)."""
+    from .. import analysis
+    x0 = lattice.x0
+    seg = None if flaw is None else (flaw["toe"], flaw["tip"])
+    r = analysis.crack_report(fields, lattice, arch_tunnel_holes(), soft_end, rock=rock, axis_x=TUNNEL_WIDTH / 2, flaw=seg,
+                              point=None if flaw is None else flaw["toe"], band_gap=BAND_GAP, band_fraction=BAND_FRACTION,
+                              band_floor=BAND_MIN, point_radius=TOE_RADIUS, opening_dist=tunnel_opening_distance(x0))
+    for b in r["bands"] + r["cracks"]:
+        b["side"] = "left" if b["centroid"][0] < TUNNEL_WIDTH / 2 else "right"
+        b["location"] = tunnel_location(b["centroid"], flaw)
+    sp = r["spalled"]
+    out = {k: r[k] for k in ("symmetry_damage", "symmetry_plastic", "damaged_fraction", "softened_fraction")}
+    out.update(spalled_area_mm2=sp["area"] * 1e6, spalled_mass_kg_per_m=sp["mass"], spalled_particles=int(sp["mask"].sum()),
+               spalled_fragments=sp["fragments"], spalling_at=tunnel_where(x0[r["surface"]], flaw),
+               band_threshold=r["band_threshold"], bands=r["bands"][:6], cracks=r["cracks"][:6])
+    if flaw is not None:
+        out.update(toe_damaged=r["point_damaged"], toe_softened=r["point_softened"],
+                   toe_link_to_opening=tunnel_where(x0[r["point_failed_reach"]], flaw),
+                   toe_plastic_link_to_opening=tunnel_where(x0[r["point_plastic_reach"]], flaw))
+    return out, sp["mask"]

@@ -1,0 +1,115 @@
+"""Uniaxial compression of a sandstone specimen with a flaw, paper Sec. 3.3 (Figs. 10–15), Miao et al.
+(2018) sandstone: the specimen, the open or rigid-filled flaw, the YADE platen."""
+import math
+
+import numpy as np
+
+from .. import rocks
+from ..scene import add_region, make_solver
+from .loading import PLATEN_FRICTION, PLATEN_SPEED, yade_engines, yade_filler, yade_platen
+from .tunnel import tunnel_flaw
+
+UNIAXIAL_WIDTH = 0.05              # specimen width [m]
+UNIAXIAL_HEIGHT = 0.15             # specimen height [m]
+UNIAXIAL_FLAW = (0.025, 0.002, math.radians(30.0))   # flaw length, width [m], inclination [rad], at the centre
+UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
+UNIAXIAL_VARIANTS = ("intact", "open", "filled")
+UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face [m]: spalled fragments (measured up to 14 m/s) stay on the grid
+
+
+def uniaxial_flaw_geometry(width=UNIAXIAL_WIDTH, height=UNIAXIAL_HEIGHT, flaw=UNIAXIAL_FLAW):
+    """The centred flaw as a dict like ``tunnel_flaw`` (toe, tip, centre, direction, normal, polygon…)."""
+    length, fw, angle = flaw
+    u = np.array([-math.cos(angle), math.sin(angle)])
+    center = np.array([width / 2, height / 2])
+    return tunnel_flaw(toe=center - 0.5 * length * u, length=length, width=fw, angle=angle)
+
+
+def exclude_nodes_inside(solver, polygon):
+    """Take the physical grid nodes inside `polygon` out of the WLS fits (user exclusion bit): the
+    faces of an open flaw thinner than the stencil then do not share those nodes — the same nodes a
+    rigid filler of the flaw covers (contact bit). Returns the number of nodes excluded."""
+    xn = solver.nodePositions()
+    lo, hi = np.asarray(solver.origin), np.asarray(solver.origin) + solver.spacing * np.asarray(solver.cells)
+    inside = polygon.contains(xn) & np.all((xn > lo + 1e-12) & (xn < hi - 1e-12), axis=1)
+    for i in np.nonzero(inside)[0]:
+        solver.setNodeExcluded(int(i), True)
+    return int(inside.sum())
+
+
+def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
+                  platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY",
+                  ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM):
+    """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
+    ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
+    platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
+    free-slip top), and
+      variant "intact"  no flaw,
+              "open"    the 25 × 2 mm flaw inclined 30° at the centre cut out (nodes inside excluded),
+              "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
+                        contact with μ_con = mu_con [-] and c_con = c_con [Pa].
+    filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/contact.md).
+    ramp_time [s] ≥ 0: the platen speed rises linearly from 0 over this time when the run is driven by
+    scene["advance"](n) (speed updated before each call: a staircase with n-step treads); 0 (default) starts at
+    full speed. end_cap_cells ≥ 0: the particles within this many cells of the base and of the platen get a
+    Grady–Kipp activation strain ε_D⁰ = 0.99 (Eq. 37) that tension never reaches — "end caps", so the layer
+    under the penalty contact does not crack first (doc/mpm_vs_bonded.md); 0 (default) = none.
+    side_room [m] > 0: grid beyond each free side face (default UNIAXIAL_SIDE_ROOM).
+    spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
+    the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
+    Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
+    rigid (RigidBodies), engine (MpmEngine), flaw (dict or None), width, height [m],
+    axial_stress() -> platen reaction / width [Pa, compression positive],
+    axial_strain() -> platen displacement / height [-],
+    advance(n) -> sets the (ramped) platen speed for the time O.time, then runs n steps)."""
+    if variant not in UNIAXIAL_VARIANTS:
+        raise ValueError(f"variant = {variant!r} must be one of {UNIAXIAL_VARIANTS}")
+    W, H = UNIAXIAL_WIDTH, UNIAXIAL_HEIGHT
+    flaw = uniaxial_flaw_geometry() if variant != "intact" else None
+    if flaw is not None and not (isinstance(spacing, (int, float)) and 0 < spacing <= 2 * flaw["width"]):
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {2 * flaw['width']}] m: the {flaw['width'] * 1e3:g} mm "
+                         "flaw must cut at least one full particle row")
+    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
+        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    if not (isinstance(ramp_time, (int, float)) and math.isfinite(ramp_time) and ramp_time >= 0):
+        raise ValueError(f"ramp_time = {ramp_time!r} s must be a finite number ≥ 0")
+    if not (isinstance(end_cap_cells, int) and 0 <= end_cap_cells < H / (2 * spacing)):
+        raise ValueError(f"end_cap_cells = {end_cap_cells!r} must be an integer in [0, height/(2·spacing)) = [0, {H / (2 * spacing):g})")
+    if not (isinstance(side_room, (int, float)) and math.isfinite(side_room) and side_room > 0):
+        raise ValueError(f"side_room = {side_room!r} m must be a finite number > 0")
+    from yade import O
+    from ..bodies import RigidBodies
+    rock = material or rocks.miao2018_sandstone()
+    side = side_room                               # grid room beside the free faces for spalled fragments
+    s = make_solver((-side, 0), (W + side, H), spacing, margin=2)
+    add_region(s, rock, (0, 0), (W, H), ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
+    s.addBoundaryPlane(1, -1, 0.0, "slip")
+    if end_cap_cells > 0:                          # end caps: ε_D⁰ = 0.99 (Eq. 37) near the base and the platen
+        y, e0 = s.view("x1"), s.view("eps0")
+        e0[(y < end_cap_cells * spacing) | (y > H - end_cap_cells * spacing)] = 0.99
+        del y, e0
+    if variant == "open":
+        exclude_nodes_inside(s, flaw["polygon"])
+    O.reset()
+    if not with_bodies:
+        return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H)
+    rb = RigidBodies(s)
+    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction)
+    filler = yade_filler(rb, flaw, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
+    eng = yade_engines(s, rb, label)
+    y0 = O.bodies[platen].state.pos[1]
+
+    def axial_stress():
+        return rb.force(platen)[1] / W             # the rock pushes the platen up: compression positive
+
+    def axial_strain():
+        return (y0 - O.bodies[platen].state.pos[1]) / H
+
+    def advance(n):
+        v = platen_speed * (min(1.0, O.time / ramp_time) if ramp_time > 0 else 1.0)
+        O.bodies[platen].state.vel = (0, -v, 0)
+        O.run(n, True)
+    if ramp_time > 0:
+        O.bodies[platen].state.vel = (0, 0, 0)     # at rest until the first advance()
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H,
+                   axial_stress=axial_stress, axial_strain=axial_strain, advance=advance)

@@ -1,0 +1,112 @@
+"""Particle fields for users: one vocabulary, one order.
+
+``get(solver, name)`` and ``fields(solver)`` return COPIES in particle-id order (the order of
+``add_region``'s returned ids, stable over the whole run), with YADE-like names (``pos``, ``vel``,
+``mass`` as ``b.state.pos`` …). Both stresses have a name: ``stress`` is the stress the particle carries
+(damaged for DP–GK, Eq. 40), ``undamaged_stress`` the stress of the intact material that the
+constitutive update advances (equal to ``stress`` for elastic particles and for D = 0).
+
+Power users: ``solver.view(name)`` and ``views(solver)`` are live NumPy views on the solver's own
+arrays (no copy, writable) under the core's short names (x0, v0, sig0.., epsP, vol …) in STORAGE
+order, which changes whenever the solver re-sorts its particles (every step may); ``view("id")``
+tells which particle sits in each slot. Write through them only before a step and call
+``solver.requestSort()`` afterwards; the ``id`` view is read-only (``views``, ``solver.view``).
+"""
+import numpy as np
+
+from . import _core
+
+SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz")}
+
+# name: (storage view(s) or how it is computed, unit, meaning) — the one declaration of the user fields
+FIELDS = {
+    "id": ("id", "-", "particle id (add_region's return values)"),
+    "pos": ("x", "m", "position, (N, D)"),
+    "vel": ("v", "m/s", "velocity, (N, D)"),
+    "stress": ("effectiveStress()", "Pa", "stress carried, damaged for DP–GK (Eq. 40); (N, 4) xx, yy, zz, xy in 2D, "
+               "(N, 6) xx, yy, zz, xy, xz, yz in 3D; tension positive"),
+    "undamaged_stress": ("sig", "Pa", "stress of the undamaged material (the constitutive state, Eqs. 26–33); "
+                         "components and sign as stress"),
+    "max_principal_stress": ("maxPrincipalStress()", "Pa", "largest principal value of stress (σ̃max, tension positive)"),
+    "damage": ("damage", "-", "Grady–Kipp damage D in [0, 1] (0 for elastic particles)"),
+    "plastic_strain": ("epsP", "-", "accumulated plastic strain ε̄p (0 for elastic particles)"),
+    "cohesion": ("cohesion()", "Pa", "current cohesion c(ε̄p) (Eq. 34; NaN for elastic particles); DP–GK scenes only"),
+    "mass": ("mass", "kg", "mass (per metre of thickness in 2D)"),
+    "volume": ("vol", "m³", "current volume (m² × 1 m in 2D)"),
+    "material": ("material", "-", "material index (solver.material(i))"),
+}
+_RENAMED = {"state_stress": "undamaged_stress", "sig": "stress' or 'undamaged_stress", "x": "pos", "v": "vel",
+            "epsP": "plastic_strain", "vol": "volume", "position": "pos", "velocity": "vel"}
+
+
+def dim_of(solver):
+    """2 or 3; ValueError if `solver` is not a Solver2D/Solver3D."""
+    if isinstance(solver, _core.Solver2D):
+        return 2
+    if isinstance(solver, _core.Solver3D):
+        return 3
+    raise ValueError(f"solver must be a Solver2D or Solver3D (got {type(solver).__name__})")
+
+
+def views(solver):
+    """POWER USERS: live NumPy views (STORAGE order, no copy) of every allocated particle array, keyed by
+    the core's names: x0.., v0.., sig0.. (undamaged stress xx, yy, zz, xy[, xz, yz]), mass, vol, vol0, id
+    (read-only), material (read-only), epsP, damage, eps0, nFlaw. The storage order changes when the
+    particles are re-sorted (a step may); `id` tells which particle sits in each slot. For analysis use
+    ``get`` / ``fields`` (copies, id order, user names)."""
+    d = dim_of(solver)
+    names = [f"x{a}" for a in range(d)] + [f"v{a}" for a in range(d)] + [f"sig{k}" for k in range(len(SYM_NAMES[d]))]
+    names += ["mass", "vol", "vol0", "id", "material", "epsP", "damage", "eps0", "nFlaw"]
+    out = {}
+    for n in names:
+        try:
+            out[n] = solver.view(n)
+        except ValueError:
+            pass
+    return out
+
+
+def id_order(solver):
+    """Storage slots in particle-id order (valid until the next step re-sorts the particles)."""
+    return np.argsort(solver.view("id"), kind="stable")
+
+
+def get(solver, name, order=None):
+    """Copy of the particle field `name` in particle-id order (row k = particle id k). Names (``FIELDS``):
+    id, pos, vel [m, m/s], stress (carried, damaged for DP–GK) and undamaged_stress [Pa] (xx, yy, zz, xy[,
+    xz, yz], tension positive), max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass
+    [kg], volume [m³], material. Pass order=id_order(solver) when reading several fields of one state."""
+    d = dim_of(solver)
+    if name not in FIELDS:
+        hint = f" (use '{_RENAMED[name]}')" if name in _RENAMED else ""
+        raise ValueError(f"unknown field {name!r}{hint}; fields: {', '.join(FIELDS)}")
+    o = id_order(solver) if order is None else order
+    if name in ("pos", "vel"):
+        return np.column_stack([solver.view(f"{FIELDS[name][0]}{a}") for a in range(d)])[o]
+    if name == "stress":
+        return solver.effectiveStress()[o]
+    if name == "undamaged_stress":
+        return np.column_stack([solver.view(f"sig{k}") for k in range(len(SYM_NAMES[d]))])[o]
+    if name == "max_principal_stress":
+        return solver.maxPrincipalStress()[o]
+    if name in ("damage", "plastic_strain"):
+        try:
+            return solver.view(FIELDS[name][0])[o].copy()
+        except ValueError:                       # not allocated: no DP–GK material in the scene
+            return np.zeros(solver.numParticles)
+    if name == "cohesion":
+        if 1 not in solver.materialKinds:
+            raise ValueError("cohesion exists only for the DP–GK material")
+        return solver.cohesion()[o]              # Eq. 34 with each particle's material; NaN for other materials
+    return solver.view(FIELDS[name][0])[o].copy()
+
+
+def fields(solver, names=None):
+    """Several fields of one state (default: every field of ``FIELDS`` the scene has), each a copy in
+    particle-id order, plus 'time' [s] and 'steps'; a dict ready for ``np.savez`` or ``analysis``."""
+    o = id_order(solver)
+    if names is None:
+        names = [n for n in FIELDS if n != "cohesion" or 1 in solver.materialKinds]
+    out = {n: get(solver, n, o) for n in names}
+    out["time"], out["steps"] = float(solver.time), int(solver.steps)
+    return out
