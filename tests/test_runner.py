@@ -139,7 +139,10 @@ def test_bad_arguments(kw, name):
 
 def test_real_sigint_stops_after_the_outputs(tmp_path):
     """Ctrl-C as the OS delivers it (SIGINT to this process, Python's default handler) in the middle of
-    a run: the at_end outputs see the last completed step and the .pvd lists every file written."""
+    a run: the at_end outputs see the last completed step and the .pvd lists every file written.
+    The test installs Python's default SIGINT handler itself (a process started from a non-interactive
+    background shell inherits SIGINT ignored, and the signal would be dropped) and bounds the run to 200
+    steps, so a signal that does not arrive fails it at once instead of running to end_time."""
     import signal
     s, dt = block()
     series = output.VtuSeries(str(tmp_path))
@@ -148,9 +151,13 @@ def test_real_sigint_stops_after_the_outputs(tmp_path):
         if s.steps == 25:
             os.kill(os.getpid(), signal.SIGINT)
 
-    res = runner.run(s, end_time=1.0, on_interrupt="return", every=[(10 * dt * (1 - 1e-9), series.write)],
-                     outputs=[runner.Output(ctrl_c, steps=1), runner.Output(series.write, at_end=True)])
-    assert res.reason == "interrupted" and 25 <= s.steps <= 26
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        res = runner.run(s, end_time=1.0, max_steps=200, on_interrupt="return", every=[(10 * dt * (1 - 1e-9), series.write)],
+                         outputs=[runner.Output(ctrl_c, steps=1), runner.Output(series.write, at_end=True)])
+    finally:
+        signal.signal(signal.SIGINT, old)
+    assert res.reason == "interrupted" and 25 <= s.steps <= 26, res
     files = [d.get("file") for d in ET.parse(tmp_path / "particles.pvd").getroot().iter("DataSet")]
     assert files == [f"particles_{k:08d}.vtu" for k in (10, 20, s.steps)]
     assert all((tmp_path / f).exists() for f in files)

@@ -132,3 +132,35 @@ def test_nan_stress_is_stopped_with_a_message():
     s.view("sig0")[7] = float("nan")
     with pytest.raises(ym.MpmSimulationError, match=r"step 3 .*particle id \d+ has non-finite stress"):
         s.step()
+
+
+def test_case_stopped_by_an_error_when_expected_to_finish_is_failed(tmp_path):
+    """A case forced to fail (the grid-edge scene, declared as expected to finish) is FAILED in the
+    suite's summary, the script's exit code and the report — never "passed"."""
+    import importlib.util
+    import json
+    import os
+
+    def forced(fast):
+        s, opts = st.case_grid_edge(fast)
+        return s, dict(opts, expect="finished")
+    r, _ = st.run_case("forced", forced, fast=True, progress=False)
+    assert r["outcome"] == "stopped_with_error" and r["error_message_clear"]
+    assert r["passed"] is False
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+    def script(name):
+        spec = importlib.util.spec_from_file_location(name, os.path.join(root, "scripts", f"{name}.py"))
+        m = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(m)
+        return m
+    stab = script("stability")
+    stab.CASES = dict(st.CASES, forced=(forced, "grid edge, declared as expected to finish"))
+    assert stab.main(["--out", str(tmp_path / "stability"), "--fast", "--cases", "forced,grid_edge"]) == 1
+    s = json.load(open(tmp_path / "stability" / "summary.json"))
+    assert s["all_passed"] is False and [c["passed"] for c in s["cases"]] == [False, True]
+    rep = script("report")
+    R = rep.Report(str(tmp_path), str(tmp_path / "doc"))
+    rep.stability(R)
+    text = "\n".join(R.lines)
+    assert "FAILED: forced" in text and "passed (each" not in text
