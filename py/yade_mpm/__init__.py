@@ -11,8 +11,13 @@ import os as _os
 # Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE); users may override.
 _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
+from . import _guards
+_guards.cap_omp_threads()   # before libgomp reads OMP_NUM_THREADS (loaded with _core)
 from ._core import (Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D,
                     dpgkFlawThresholds, dpgkThresholdScale)
+from . import _core
+_guards.install(_core)      # Solver.view("id") read-only, Solver.reserve(n) checked against the memory
+_guards.cap_core_threads(_core)
 from .materials import ElasticMat, DpGkMat
 from .fields import get, fields, FIELDS, id_order, views, SYM_NAMES
 from .scene import (check_setting, make_solver, add_region, set_initial_stress, boundary_particles, apply_traction,

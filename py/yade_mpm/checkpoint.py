@@ -7,27 +7,17 @@
     ...
     ym.checkpoint.save("run.ckpt")            # between O.run(n, True) calls (or Solver.run calls)
 
-A checkpoint holds, per MPM solver, every particle array in storage order (the particles are sorted
-by block, so the order is state), the clock (time, steps, last Δt), the external work, the block
-schedule of the last sort and the values the next step reads without recomputing them (whether a
-re-sort is due, max‖v‖, ρ_min, the nodal mass floor), plus the solver settings (``Solver.settings()``,
-the one declaration in SolverSettings.hpp). With YADE it also
-holds the YADE scene written by ``O.save`` (bodies and their state, engines, O.time, O.iter, O.dt),
-the body states once more (checked bitwise after ``O.load``) and the state of the Python-side engines
-(``MpmEngine``: the O.dt the user asked for). A run resumed from it is bitwise identical to the
-uninterrupted run for the same thread count.
-
-The scene itself is not rebuilt from the file: the script builds it as usual (same grid, particles,
-materials, bodies) and ``load`` overwrites the state. ``load`` first reads and checks the whole file
-and refuses, with a ``CheckpointError`` (a ``ValueError``) and nothing changed, a truncated or
-corrupted file, one written by another checkpoint format or another build of the core, or one whose
-scene differs from the one built (grid, particle count, masses, initial volumes, loads, material,
-YADE bodies and engines). After ``O.load`` the ``MpmEngine`` registry (the PyRunner commands name the
-engines by label) is restored, so ``yade_mpm.engine(label)`` works again.
-
-``Checkpointer`` (``yade_mpm.resumable``) adds the run-loop side: a checkpoint every N steps or every M
-wall minutes, and SIGINT / SIGTERM turned into "write a last checkpoint and the outputs, then stop
-cleanly"; ``resumable.ResumableRun`` is a whole run built on it (resume, solver errors, state file).
+A checkpoint holds, per MPM solver, every particle array in storage order (the sort order is state),
+the clock, the external work, the block schedule, the values the next step reads without recomputing
+them and the solver settings (``Solver.settings()``); with YADE also the scene written by ``O.save``,
+the body states once more (checked bitwise after ``O.load``) and the ``MpmEngine`` state. A resumed run
+is bitwise identical to the uninterrupted one for the same thread count. The script builds the scene
+as usual and ``load`` overwrites its state, after checking the whole file: a truncated or corrupted
+file, another format or build of the core, or another scene (grid, particles, materials, loads, YADE
+bodies and engines) is refused with a ``CheckpointError`` (a ``ValueError``), nothing changed. The
+``MpmEngine`` registry is restored after ``O.load`` (doc/checkpoint.md). The run-loop side, periodic
+checkpoints and clean stops on SIGINT / SIGTERM, is ``Checkpointer`` and ``ResumableRun`` in
+``yade_mpm.resumable``.
 """
 import hashlib
 import io
@@ -90,7 +80,7 @@ def _particle_arrays(solver):
     if len(out) != nreal:
         raise CheckpointError(f"the core holds {nreal} particle arrays but the checkpoint knows {len(out)} "
                               f"({', '.join(out)}); update yade_mpm.checkpoint._field_names")
-    out["id"] = solver.view("id")
+    out["id"] = solver._view_raw("id")          # writable: the restore writes the saved ids (user views are read-only)
     out["material"] = solver.view("material")    # material index per particle (uint8), follows the sort like id
     return out
 
@@ -224,6 +214,8 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
     the same meta refuses a checkpoint with another one); extra: JSON-able state of the calling script
     (e.g. the curve recorded so far), returned by ``load`` as ``header["extra"]``. Call between steps
     (not from inside a PyRunner). Returns the number of bytes written."""
+    if os.path.isdir(path):
+        raise ValueError(f"checkpoint path {path} is a directory: give a file name, e.g. {os.path.join(path, 'run.ckpt')}")
     O = _yade_O()
     with_yade = (O is not None and (len(O.bodies) > 0 or len(O.engines) > 0)) if yade is None else bool(yade)
     if with_yade and O is None:
@@ -248,7 +240,7 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
         arrays["yade/bodies"] = _body_state(O)
         arrays["yade/clock"] = np.array([O.time, float(O.iter), O.dt], dtype=np.float64)
         engines = _engines_in_scene(O)
-        header["yade"] = dict(yade_fingerprint(O), mpm_engines={lab: dict(e.checkpoint_state(), solver=_name_of(e.solver, sol))
+        header["yade"] = dict(yade_fingerprint(O), mpm_engines={lab: dict(e.checkpoint_state(), solver=next((k for k, v in sol.items() if v is e.solver), None))
                                                                  for lab, e in engines.items()})
     buf = io.BytesIO()
     np.savez(buf, **arrays)
@@ -258,19 +250,16 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
     hb = json.dumps(header).encode()
     tmp = f"{path}.tmp-{os.getpid()}"
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with open(tmp, "wb") as f:
-        f.write(MAGIC + struct.pack("<Q", len(hb)) + hb + payload)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as f:
+            f.write(MAGIC + struct.pack("<Q", len(hb)) + hb + payload)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:                                       # a failed write leaves no temporary file behind
+        if os.path.exists(tmp):
+            os.remove(tmp)
     return len(MAGIC) + 8 + len(hb) + len(payload)
-
-
-def _name_of(solver, sol):
-    for k, v in sol.items():
-        if v is solver:
-            return k
-    return None
 
 
 # -------------------------------------------------------------------------------------------- load
@@ -293,7 +282,9 @@ def read(path):
     try:
         header = json.loads(raw[p + 8:p + 8 + hl])
     except ValueError:
-        raise CheckpointError(f"checkpoint {path}: corrupted header") from None
+        header = None
+    if not isinstance(header, dict):
+        raise CheckpointError(f"checkpoint {path}: corrupted header (not a JSON object)")
     if header.get("format") != FORMAT:
         raise CheckpointError(f"checkpoint {path}: format version {header.get('format')}, this yade_mpm reads version {FORMAT} "
                               "only (checkpoints are not converted between formats: rerun from the start, or resume with the "

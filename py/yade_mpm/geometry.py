@@ -5,11 +5,13 @@ import numpy as np
 
 
 def _number(v, name, unit, positive=False):
-    """A finite float (> 0 if positive) or ValueError naming the parameter, unit and range."""
+    """A finite float (> 0 if positive) or ValueError naming the parameter, unit and range. NumPy scalars
+    are numbers; a float32 is read as the decimal it prints as (np.float32(0.002) → 0.002, not
+    0.0020000000949949: a grid spacing must divide the specimen exactly)."""
     try:
         if isinstance(v, (bool, np.bool_, str, bytes)):
             raise TypeError
-        f = float(v)
+        f = float(str(v)) if isinstance(v, np.floating) and v.dtype.itemsize < 8 else float(v)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number [{unit}] (got {type(v).__name__} {v!r})") from None
     if not np.isfinite(f) or (positive and not f > 0):
@@ -17,7 +19,7 @@ def _number(v, name, unit, positive=False):
     return f
 
 
-def _point(v, name, dims=(2, 3)):
+def _point(v, name, dims=(2, 3), hole=True):
     """A finite point with 2 or 3 components [m], or ValueError naming the parameter."""
     try:
         p = np.asarray(v, float)
@@ -26,7 +28,7 @@ def _point(v, name, dims=(2, 3)):
     if p.ndim != 1 or len(p) not in dims:
         raise ValueError(f"{name} must have {' or '.join(map(str, dims))} components [m] (got shape {p.shape})")
     if not np.all(np.isfinite(p)):
-        raise ValueError(f"{name} = {tuple(p.tolist())} m must be finite (a NaN or inf coordinate removes nothing)")
+        raise ValueError(f"{name} = {tuple(p.tolist())} m must be finite" + (" (a NaN or inf coordinate removes nothing)" if hole else ""))
     return p
 
 
@@ -39,7 +41,7 @@ def _integer(v, name, lo, hi=None):
 
 def _corners(lo, hi, who):
     """Finite corners lo < hi of a box with 2 or 3 components, or ValueError naming them."""
-    lo, hi = _point(lo, f"{who} lo"), _point(hi, f"{who} hi")
+    lo, hi = _point(lo, f"{who} lo", hole=who in ("Box",)), _point(hi, f"{who} hi", hole=who in ("Box",))
     if lo.shape != hi.shape:
         raise ValueError(f"{who} lo and hi must both have 2 (plane strain) or 3 components")
     if np.any(hi <= lo):

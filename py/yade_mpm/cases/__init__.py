@@ -17,10 +17,11 @@ tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies). Quantities are SI; 
 """
 from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING_SXX, OPENING_SYY, apply_far_field,
                       circular_opening, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
-from .loading import BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, yade_engines, yade_filler, yade_platen
+from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler,
+                      yade_platen)
 from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_WIDTH, TUNNEL_CASES,
                      TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
                      arch_tunnel, arch_tunnel_holes, arch_tunnel_specimen, tunnel_flaw, tunnel_location,
                      tunnel_opening_distance, tunnel_report, tunnel_where)
 from .uniaxial import (UNIAXIAL_FLAW, UNIAXIAL_HEIGHT, UNIAXIAL_PAPER_SPACING, UNIAXIAL_SIDE_ROOM, UNIAXIAL_VARIANTS,
-                       UNIAXIAL_WIDTH, exclude_nodes_inside, uniaxial_flaw, uniaxial_flaw_geometry)
+                       UNIAXIAL_MAX_SPACING, UNIAXIAL_WIDTH, exclude_nodes_inside, uniaxial_flaw, uniaxial_flaw_geometry)

@@ -22,6 +22,15 @@ def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0
     return pid
 
 
+def blocked_dofs(value, name="blockedDOFs"):
+    """A YADE blockedDOFs string: letters of 'xyzXYZ' (x, y, z translation; X, Y, Z rotation), each at
+    most once ('' = free); ValueError naming `name` otherwise (YADE ignores unknown letters silently)."""
+    if not isinstance(value, str) or any(c not in "xyzXYZ" for c in value) or len(set(value)) != len(value):
+        raise ValueError(f"{name} = {value!r} must be letters of 'xyzXYZ' (x, y, z translation, X, Y, Z rotation), each at most "
+                         "once, e.g. 'zXY' (free in the x–y plane) or 'zXYZ' (no rotation)")
+    return value
+
+
 def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None):
     """A free rigid YADE Box that is the flaw (dict of ``tunnel_flaw``): the domain of the filling, its
     length × width, registered in `rb` with d0 = "initial" (doc/contact.md) so the particles next to it —
@@ -34,6 +43,7 @@ def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", c
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3
     from yade.wrapper import FrictMat
+    blocked = blocked_dofs(blocked, "blocked")
     ang = math.atan2(flaw["direction"][1], flaw["direction"][0])
     kw = {} if density is None else dict(material=FrictMat(density=density))
     fid = O.bodies.append(utils.box((flaw["center"][0], flaw["center"][1], 0), (0.5 * flaw["length"], 0.5 * flaw["width"], BODY_HALF_THICKNESS),

@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from .. import rocks
-from ..geometry import Box, Circle, rotated_rectangle
+from ..geometry import Box, Circle, _number, rotated_rectangle
 from ..scene import add_region, make_solver
 from .loading import PLATEN_FRICTION, PLATEN_SPEED, yade_engines, yade_filler, yade_platen
 
@@ -29,7 +29,18 @@ def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floo
                          holes=()):
     """The tunnel specimen [0, width]² with the arch opening (and further `holes`), free-slip walls on
     `walls` (the paper's four sides minus the loaded top, where the caller puts a platen or a traction).
-    material: default ``rocks.pan2020_sandstone()``. Returns the solver."""
+    material: default ``rocks.pan2020_sandstone()``. The opening must lie inside the specimen with at
+    least one cell of rock around it: width ≥ 40 mm + 2·spacing, floor ≥ spacing and
+    floor + 45 mm (rectangle and roof) ≤ width − spacing. Returns the solver."""
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    width, floor = _number(width, "width", "m", positive=True), _number(floor, "floor", "m")
+    if width < TUNNEL_RECT[0] + 2 * spacing:
+        raise ValueError(f"width = {width:g} m: the specimen must be at least the opening's width {TUNNEL_RECT[0]:g} m plus a cell "
+                         f"of rock on each side, width ≥ {TUNNEL_RECT[0] + 2 * spacing:g} m")
+    top = TUNNEL_RECT[1] + TUNNEL_RADIUS                  # the opening's height above its floor
+    if not spacing <= floor <= width - spacing - top:
+        raise ValueError(f"floor = {floor:g} m puts the opening (height {top:g} m) outside or through the {width:g} m specimen: "
+                         f"allowed floor in [{spacing:g}, {width - spacing - top:g}] m (one cell of rock below and above)")
     planes = {"left": (0, -1, 0.0), "right": (0, 1, width), "bottom": (1, -1, 0.0), "top": (1, 1, width)}
     bad = [w for w in walls if w not in planes]
     if bad:
@@ -90,11 +101,11 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     platen_displacement() -> downward platen displacement since the build [m])."""
     if case not in TUNNEL_CASES:
         raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
-    if not (isinstance(spacing, (int, float)) and 0 < spacing <= TUNNEL_MAX_SPACING):
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    if not spacing <= TUNNEL_MAX_SPACING:
         raise ValueError(f"spacing = {spacing!r} m must be in (0, {TUNNEL_MAX_SPACING}] m (the {FLAW_WIDTH * 1e3:g} mm flaw must "
                          "cut at least one full particle row, particle spacing l/2)")
-    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
-        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
+    platen_speed = _number(platen_speed, "platen_speed", "m/s", positive=True)
     from yade import O
     from ..bodies import RigidBodies
 

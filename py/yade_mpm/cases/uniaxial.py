@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import rocks
 from ..scene import add_region, make_solver
-from .loading import PLATEN_FRICTION, PLATEN_SPEED, yade_engines, yade_filler, yade_platen
+from ..geometry import _integer, _number
+from .loading import PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler, yade_platen
 from .tunnel import tunnel_flaw
 
 UNIAXIAL_WIDTH = 0.05              # specimen width [m]
@@ -14,6 +15,7 @@ UNIAXIAL_HEIGHT = 0.15             # specimen height [m]
 UNIAXIAL_FLAW = (0.025, 0.002, math.radians(30.0))   # flaw length, width [m], inclination [rad], at the centre
 UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
 UNIAXIAL_VARIANTS = ("intact", "open", "filled")
+UNIAXIAL_MAX_SPACING = UNIAXIAL_WIDTH / 10   # coarsest grid [m]: 10 cells across the specimen (a coarser one ran with 3–5 particles)
 UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face [m]: spalled fragments (measured up to 14 m/s) stay on the grid
 
 
@@ -66,17 +68,18 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         raise ValueError(f"variant = {variant!r} must be one of {UNIAXIAL_VARIANTS}")
     W, H = UNIAXIAL_WIDTH, UNIAXIAL_HEIGHT
     flaw = uniaxial_flaw_geometry() if variant != "intact" else None
-    if flaw is not None and not (isinstance(spacing, (int, float)) and 0 < spacing <= 2 * flaw["width"]):
-        raise ValueError(f"spacing = {spacing!r} m must be in (0, {2 * flaw['width']}] m: the {flaw['width'] * 1e3:g} mm "
-                         "flaw must cut at least one full particle row")
-    if not (isinstance(platen_speed, (int, float)) and math.isfinite(platen_speed) and platen_speed > 0):
-        raise ValueError(f"platen_speed = {platen_speed!r} m/s must be a finite number > 0")
-    if not (isinstance(ramp_time, (int, float)) and math.isfinite(ramp_time) and ramp_time >= 0):
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    top = UNIAXIAL_MAX_SPACING if flaw is None else min(UNIAXIAL_MAX_SPACING, 2 * flaw["width"])
+    if not spacing <= top:
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {top:g}] m: " + ("the specimen must be at least 10 cells wide"
+                         if flaw is None else f"the {flaw['width'] * 1e3:g} mm flaw must cut at least one full particle row"))
+    platen_speed = _number(platen_speed, "platen_speed", "m/s", positive=True)
+    ramp_time = _number(ramp_time, "ramp_time", "s")
+    if ramp_time < 0:
         raise ValueError(f"ramp_time = {ramp_time!r} s must be a finite number ≥ 0")
-    if not (isinstance(end_cap_cells, int) and 0 <= end_cap_cells < H / (2 * spacing)):
-        raise ValueError(f"end_cap_cells = {end_cap_cells!r} must be an integer in [0, height/(2·spacing)) = [0, {H / (2 * spacing):g})")
-    if not (isinstance(side_room, (int, float)) and math.isfinite(side_room) and side_room > 0):
-        raise ValueError(f"side_room = {side_room!r} m must be a finite number > 0")
+    end_cap_cells = _integer(end_cap_cells, "end_cap_cells", 0, math.ceil(H / (2 * spacing)) - 1)
+    side_room = _number(side_room, "side_room", "m", positive=True)
+    blocked_dofs(filler_blocked, "filler_blocked")
     from yade import O
     from ..bodies import RigidBodies
     rock = material or rocks.miao2018_sandstone()
