@@ -13,6 +13,7 @@
 // of contact parameters. `query(x)` gives the signed distance (> 0 outside), the outward unit normal at
 // the closest surface point and the part owning that point; `velocityAt(part, x)` = v + ω × (x − c).
 #pragma once
+#include "ContactParams.hpp"
 #include "MpmTypes.hpp"
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -38,33 +39,6 @@ inline SpinOf<D> momentOf(const typename Dim<D>::Vec& r, const typename Dim<D>::
 	if constexpr (D == 2) return SpinOf<D>(r[0] * f[1] - r[1] * f[0]);
 	else return r.cross(f);
 }
-
-// Contact parameters of one group (Sec. 2.3); every one validated by validate() with its name and range.
-struct ContactParams {
-	Real mu       = 0;    // Coulomb friction coefficient μ_con [-], ≥ 0
-	Real cohesion = 0;    // contact cohesion c_con [Pa], ≥ 0
-	// residual penetration factor χ [-], 0 ≤ χ < 1. Default ½: positions advance with the updated velocity
-	// (x += Δt v^{n+1}), so (1 − χ) κ = m/Δt² takes a penetrating particle back to d0 in exactly one step;
-	// χ = 0 pushes it out by twice its penetration (the contact layer is reflected; measured +15 % total
-	// energy at the first contact of a 3D block dropped on a wall, none with χ = ½).
-	Real chi      = 0.5;
-	Real d0       = 0;    // detection distance d0 [m], ≥ 0; used when autoD0 is false
-	bool autoD0   = true; // d0 = ½ V_p^{1/D}: half the particle's edge, i.e. contact when the particle's face touches
-	// d0 = "initial" (with autoD0): the paper's d0 is "the initial distance of particle used for the contact
-	// detection" (text after Eq. 26). The particles of the first lattice layer next to the surface when the
-	// group is registered get d0_p = d_p(0), their initial signed distance — a body filling a domain (a flaw
-	// filler) touches the material around it at zero force from t = 0; every other particle keeps ½ V_p^{1/D}.
-	// First layer: d_p(0) < e_p max_i |n_i| (e_p = V_p^{1/D}, n the outward normal at the closest point):
-	// one particle per lattice line along the dominant normal axis, for any face angle (PtsContact::captureInitialD0).
-	bool initialD0 = false;
-	void validate() const
-	{
-		requireRange(mu, 0, INFINITY, false, true, "contact friction coefficient mu", "[-]");
-		requireRange(cohesion, 0, INFINITY, false, true, "contact cohesion", "[Pa]");
-		requireRange(chi, 0, 1, false, true, "residual penetration factor chi", "[-]");
-		if (!autoD0) requireRange(d0, 0, INFINITY, false, true, "detection distance d0", "[m]");
-	}
-};
 
 template <int D>
 struct RigidPart {
@@ -105,8 +79,8 @@ struct RigidPart {
 
 	void setState(const Vec& c_, const Mat& R_, const Vec& v_, const SpinOf<D>& w_)
 	{
-		for (int a = 0; a < D; ++a) requireFinite(c_[a], "rigid body position"), requireFinite(v_[a], "rigid body velocity");
-		for (int k = 0; k < w_.size(); ++k) requireFinite(w_[k], "rigid body angular velocity");
+		for (int a = 0; a < D; ++a) requireFinite(c_[a], "rigid body position [m]"), requireFinite(v_[a], "rigid body velocity [m/s]");
+		for (int k = 0; k < w_.size(); ++k) requireFinite(w_[k], "rigid body angular velocity [rad/s]");
 		const Real orth = (R_.transpose() * R_ - Mat::Identity()).cwiseAbs().maxCoeff();
 		if (!(orth < 1e-6) || !(R_.determinant() > 0)) throw InputError("rigid body orientation must be a rotation matrix (orthonormal, det = +1)");
 		c = c_, R = R_, v = v_, w = w_;

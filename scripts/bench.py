@@ -241,6 +241,7 @@ def run_spheres(name, steps, warmup):
         sp.state.blockedDOFs = "zXY"
         O.bodies.append(sp)
     bodies = ym.DemSpheres(b)
+    bodies.add("all", mu=0.0)                 # frictionless, as when this benchmark was recorded
     O.engines = engines(b, "mpmWithSpheres", bodies)
     O.dt = 1.0
     O.run(warmup, True)

@@ -96,7 +96,9 @@ def build(a):
         O.bodies[cid].state.blockedDOFs = "zXY"
         throw(cid, 3.0, -a.speed)
         ids.append(cid)
-    return s, ym.DemSpheres(s, ids=ids, mu=0.5), ids
+    sp = ym.DemSpheres(s)
+    sp.add(ids, mu=0.5)
+    return s, sp, ids
 
 
 def engines(s, bodies):

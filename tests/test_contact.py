@@ -32,7 +32,7 @@ def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5):
     s.addParticles(x, np.full(len(x), sp ** d), np.full(len(x), sp ** d * ELASTIC["density"]))
     s.gravity = (0, -G, 0)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], mu, cohesion, chi, None)
+    g = s.addContactGroup([p], ym.contact_params(mu=mu, cohesion=cohesion, chi=chi, d0=None))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), (1.0, 0.1, 1.0)[:d])
     s.setRigidPartState(p, c0 - 0.1 * R[:, 1], R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s, p, R[:, 0], l, s.view("mass").sum()
@@ -114,7 +114,7 @@ def _drop(d, chi=None):
     ym.add_region(s, ym.ElasticMat(young=1e6, poisson=0.25, density=1000.0), (0.1, 0.1, 0.04)[:d], (0.3, 0.2, 0.12)[:d])
     s.gravity = (0, -G, 0)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], 0.0, 0.0, ym.CONTACT_DEFAULTS["chi"] if chi is None else chi, None)
+    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=None))
     n = np.zeros(d)
     n[1] = 1
     s.addContactPlane(g, p, np.zeros(d), n, False)   # the wall y = 0, material above
@@ -154,7 +154,7 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d):
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0.2, 0.2, 0.1)[:d], (0.8, 0.5, 0.5)[:d])
     s.gravity = (0.3, -G, 0.2)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], 0.4, 1e3, 0.5, None)
+    g = s.addContactGroup([p], ym.contact_params(mu=0.4, cohesion=1e3, chi=0.5, d0=None))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), (0.15, 0.1, 0.15)[:d])
     c = np.array([0.45, 0.59, 0.3][:d])
     R = _rot(d, 0.2)
@@ -307,7 +307,7 @@ def test_bad_contact_input_is_refused_naming_it():
     with pytest.raises(ValueError, match="does not cross the plane z = 0"):
         rb.add(far)
     with pytest.raises(ValueError, match="chi"):
-        s.addContactGroup([s.addRigidPart()], 0.0, 0.0, 1.0, None)
+        s.addContactGroup([s.addRigidPart()], ym.contact_params(mu=0.0, cohesion=0.0, chi=1.0, d0=None))
     assert not s.contactActive                       # nothing was registered by the refused calls
 
 

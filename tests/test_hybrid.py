@@ -62,6 +62,7 @@ def test_dropped_sphere_rebounds():
     s = _block(floor=True)
     bid = O.bodies.append(_sphere(0.1, 0.1 + R + 0.005, -1.0))
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(s, sp, gravity=-9.81)
     _collide(s, sp, bid)
     v = O.bodies[bid].state.vel[1]
@@ -79,6 +80,7 @@ def test_impulse_on_sphere_is_minus_impulse_on_particles():
     s = _block(floor=False)
     bid = O.bodies.append(_sphere(0.1, 0.1 + R + 0.002, -1.0))
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(s, sp)
     p0, v0 = _momentum(s), np.array(O.bodies[bid].state.vel)[:2]
     _collide(s, sp, bid)
@@ -101,6 +103,7 @@ def test_3d_sphere_impulse_balance_and_rebound():
     bid = O.bodies.append(utils.sphere((0.05, 0.06 + R + 0.002, 0.06), R, material=FrictMat(density=2000.0)))
     O.bodies[bid].state.vel = (0.0, -1.0, 0.0)
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(s, sp)
     p0, v0 = _momentum(s), np.array(O.bodies[bid].state.vel)
     _collide(s, sp, bid)
@@ -119,6 +122,7 @@ def test_sphere_resting_on_block_comes_to_rest():
     s.damping = 0.3
     bid = O.bodies.append(_sphere(0.1, 0.1 + R, 0.0))
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(s, sp, gravity=-9.81)
     O.run(2000, True)
     b = O.bodies[bid]
@@ -142,6 +146,7 @@ def test_clump_acts_like_a_sphere():
         s = _block(floor=False)
         bid = O.bodies.append(_sphere(0.1, 0.1 + R + 0.002, -1.0))
         sp = ym.DemSpheres(s)
+        sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
         _run(s, sp)
         m, I = O.bodies[bid].state.mass, O.bodies[bid].state.inertia
         n = _collide(s, sp, bid)
@@ -157,6 +162,7 @@ def test_clump_acts_like_a_sphere():
     c.state.blockedDOFs = "zXY"
     c.state.vel = (0.0, -1.0, 0.0)
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     assert list(sp.ids) == [cid]
     _run(s, sp)
     n2 = _collide(s, sp, cid)
@@ -170,6 +176,7 @@ def test_clump_acts_like_a_sphere():
     c.state.blockedDOFs = "zXY"
     c.state.vel = (0.0, -1.0, 0.0)
     sp = ym.DemSpheres(s)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(s, sp)
     p0 = _momentum(s)
     _collide(s, sp, cid)
@@ -189,6 +196,7 @@ def test_far_spheres_are_skipped_and_change_nothing():
     for k in range(100):
         O.bodies.append(_sphere(2.0 + 0.07 * (k % 10), 1.0 + 0.07 * (k // 10), 0.0))
     sp = ym.DemSpheres(a)
+    sp.add("all", mu=0.0)                        # frictionless (the tests were written with mu = 0)
     _run(a, sp)
     O.run(400, True)
     for _ in range(400):
@@ -211,8 +219,9 @@ def test_platen_and_sphere_in_one_engine():
     box = O.bodies.append(utils.box((0.05, 0.1 + 0.02 + 1e-4, 0.0), (0.03, 0.02, 0.05), fixed=True))
     O.bodies[box].state.vel = (0.0, -0.02, 0.0)
     rb = ym.RigidBodies(s)
-    rb.add(box)
-    sp = ym.DemSpheres(s, ids=[bid])
+    rb.add(box, mu=0.0)
+    sp = ym.DemSpheres(s)
+    sp.add([bid], mu=0.0)
     with pytest.raises(ValueError, match="list of them"):
         ym.MpmEngine(s, label="mpmBad", bodies=[rb, object()])
     _run(s, [rb, sp], gravity=-9.81)
@@ -232,13 +241,13 @@ def test_bad_input():
     box = O.bodies.append(utils.box((0, 1, 0), (0.1, 0.1, 0.1)))
     sph = O.bodies.append(_sphere(0.1, 0.5, 0.0))
     with pytest.raises(ValueError, match="shape Box"):
-        ym.DemSpheres(s, ids=[box])
+        ym.DemSpheres(s).add([box])
     with pytest.raises(ValueError, match="max_check_steps"):
-        ym.DemSpheres(s, ids=[sph], max_check_steps=0)
+        ym.DemSpheres(s, max_check_steps=0)
     with pytest.raises(ValueError, match="mu"):
-        ym.DemSpheres(s, ids=[sph], mu=-1.0)
+        ym.DemSpheres(s).add([sph], mu=-1.0)
     with pytest.raises(ValueError, match="does not exist"):
-        ym.DemSpheres(s, ids=[99])
+        ym.DemSpheres(s).add([99])
     far = O.bodies.append(utils.sphere((0.5, 0.5, 1.0), 0.05))
     with pytest.raises(ValueError, match="does not cross the plane"):
-        ym.DemSpheres(s, ids=[far])
+        ym.DemSpheres(s).add([far])

@@ -24,7 +24,8 @@ from .scene import (check_setting, make_solver, add_region, set_initial_stress, 
                     apply_face_traction, consistent_row_weights)
 from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
-from .bodies import RigidBodies, CONTACT_DEFAULTS
+from ._core import ContactParams
+from .bodies import RigidBodies, contact_params
 from .spheres import DemSpheres
 from .progress import Progress
 from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene builders, run loop, result files)
@@ -32,6 +33,6 @@ from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
            "check_setting", "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
-           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "CONTACT_DEFAULTS", "DemSpheres",
+           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "ContactParams", "contact_params", "DemSpheres",
            "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
            "dpgkThresholdScale"]

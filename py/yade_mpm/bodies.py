@@ -27,49 +27,107 @@ their vertices; a wall: 1 m), or the ``thickness`` given to ``add``. The force a
 per metre of the plane-strain slice: its dynamics match the MPM side for any t. ``force(id)`` and
 ``torque(id)`` return the per-metre values. A 2D body must stay in the plane (rotation about z only).
 
-Contact parameters (defaults and units; each validated with its range before any step):
-  mu        Coulomb friction coefficient μ_con [-], ≥ 0; default 0 (frictionless)
-  cohesion  contact cohesion c_con [Pa], ≥ 0; default 0
-  chi       residual penetration factor χ [-], 0 ≤ χ < 1; default ½: with positions advanced by the
-            updated velocity, (1 − χ)·2m/Δt² = m/Δt² takes a penetrating particle back to d0 in one step
-            (χ = 0 reflects the contact layer and gained 15 % energy at a 3D impact)
-  d0        detection distance d0 [m], ≥ 0; default None = ½ V_p^{1/D}, half the particle's own edge:
-            a particle stands for a cell of edge V_p^{1/D} centred on it, so contact starts when that
-            cell's face reaches the surface (for ppc = 2 this is a quarter of the grid spacing).
-            "initial": the paper's "initial distance of particle" — the particles of the first lattice
-            layer next to the body when ``add`` registers it get d0 = their initial distance to its surface
-            (they touch it at zero force from t = 0: a body filling a domain, e.g. a flaw filler); the
-            others keep ½ V_p^{1/D}. The body must not overlap any particle centre (ValueError).
+Contact parameters: the keywords ``mu``, ``cohesion``, ``chi``, ``d0`` of ``add`` (the same for
+``DemSpheres.add``) make one ``ym.ContactParams``, whose parameters are declared once, with unit, range,
+default and equation, in pkg-mpm/ContactParams.hpp (``print(ym.materials.describe(ym.ContactParams))``;
+table in doc/contact.md). Every keyword is checked before any work; NumPy scalars are numbers.
+  mu        friction coefficient μ_con [-]. Not given: tan(frictionAngle) of the bodies' YADE ``FrictMat``
+            (``b.material``; a clump: its members'), the friction a YADE user sets on the body; explicit
+            values win; bodies of one ``add`` with different friction angles need an explicit mu; a
+            material without frictionAngle gives the declared default.
+  d0        None (default): ½ V_p^{1/D}, half the particle's own edge (autoD0); a number: fixed d0 [m], at most
+            one grid spacing; "initial": the paper's "initial distance of particle" — the particles of the
+            first lattice layer next to the body when ``add`` registers it get d0 = their initial distance to
+            its surface (a body filling a domain, e.g. a flaw filler); the body must not overlap any particle
+            centre (ValueError).
+  cohesion, chi: given or the declared defaults.
 """
+import math
+import numbers
+
 import numpy as np
 
-from . import _core
+from ._core import ContactParams
 from .scene import dim_of
 
-CONTACT_DEFAULTS = dict(_core.contactDefaults())   # declared once, in ContactParams (RigidSurface.hpp)
+D0_CHOICES = "None (half the particle edge) or 'initial' (the first layer's initial distance)"
 
 
-def _check_params(mu, cohesion, chi, d0, thickness):
-    def bad(name, v, rng):
-        raise ValueError(f"{name} = {v!r} is outside the allowed range {rng}")
-    for name, v, ok, rng in (("mu", mu, lambda x: x >= 0, "[0, inf) [-]"),
-                             ("cohesion", cohesion, lambda x: x >= 0, "[0, inf) [Pa]"),
-                             ("chi", chi, lambda x: 0 <= x < 1, "[0, 1) [-]")):
-        if not (isinstance(v, (int, float)) and np.isfinite(v) and ok(v)):
-            bad(name, v, rng)
-    if not (d0 is None or (isinstance(d0, str) and d0 == "initial")
-            or (isinstance(d0, (int, float)) and not isinstance(d0, bool) and np.isfinite(d0) and d0 >= 0)):
-        bad("d0", d0, "[0, inf) [m], None (half the particle edge) or 'initial' (the first layer's initial distance)")
-    if thickness is not None and not (isinstance(thickness, (int, float)) and np.isfinite(thickness) and thickness > 0):
-        bad("thickness", thickness, "(0, inf) [m] or None (the body's z-extent)")
+def contact_params(mu=None, cohesion=None, chi=None, d0=None):
+    """``ContactParams`` from the registration keywords (None: the declared default; d0: None, "initial" or a
+    number [m], see the module docstring). Ranges come from the declaration (ValueError naming the keyword)."""
+    kw = {k: v for k, v in (("mu", mu), ("cohesion", cohesion), ("chi", chi)) if v is not None}
+    if isinstance(d0, str):
+        if d0 != "initial":
+            raise ValueError(f"d0 = {d0!r} is not a choice: a number [m] in [0, grid spacing], {D0_CHOICES}")
+        kw["initialD0"] = True
+    prm = ContactParams(**kw)
+    if d0 is not None and not isinstance(d0, str):
+        try:
+            prm.d0, prm.autoD0 = d0, False
+        except ValueError as e:
+            raise ValueError(f"d0 = {d0!r}: {e}; other choices: {D0_CHOICES}") from None
+    return prm
+
+
+def body_ids(ids):
+    """[int] from one YADE body id or a sequence of them (NumPy integers accepted); ValueError for anything
+    else, a float id included, and for an id listed twice."""
+    def is_int(i):
+        return isinstance(i, numbers.Integral) and not isinstance(i, (bool, np.bool_))
+    if is_int(ids):
+        return [int(ids)]
+    if ids is None or isinstance(ids, (str, bytes, numbers.Number)):
+        raise ValueError(f"ids must be a YADE body id (an integer) or a list of ids (got {type(ids).__name__} {ids!r})")
+    try:
+        out = list(ids)
+    except TypeError:
+        raise ValueError(f"ids must be a YADE body id (an integer) or a list of ids (got {type(ids).__name__} {ids!r})") from None
+    for i in out:
+        if not is_int(i):
+            raise ValueError(f"ids: body id {i!r} must be an integer (got {type(i).__name__})")
+    out = [int(i) for i in out]
+    if not out:
+        raise ValueError("ids: give at least one YADE body id")
+    twice = sorted({i for i in out if out.count(i) > 1})
+    if twice:
+        raise ValueError(f"ids: body id {twice[0]} is listed twice (a body is registered for contact once)")
+    return out
+
+
+def check_thickness(thickness):
+    """The 2D thickness override: None (the body's z-extent) or a number in (0, inf) [m]."""
+    if thickness is not None and not (isinstance(thickness, numbers.Real) and not isinstance(thickness, (bool, np.bool_))
+                                      and 0 < thickness < math.inf):
+        raise ValueError(f"thickness = {thickness!r} is outside the allowed range (0, inf) [m] or None (the body's z-extent)")
+
+
+def friction_of(bodies):
+    """μ = tan(frictionAngle) of the YADE materials of `bodies` (a clump: its members'); None when none has a
+    frictionAngle; ValueError when they differ (then mu must be given)."""
+    from yade import O
+    angles = {}
+    for b in bodies:
+        mats = [O.bodies[m].material for m in b.shape.members] if type(b.shape).__name__ == "Clump" else [b.material]
+        for m in mats:
+            angles.setdefault(getattr(m, "frictionAngle", None), b.id)
+    if set(angles) == {None}:
+        return None
+    if len(angles) > 1:
+        raise ValueError("mu not given and the bodies' materials have different friction angles "
+                         f"({', '.join(f'{a!r} (body {i})' for a, i in angles.items())}); pass mu")
+    (a, bid), = angles.items()
+    if not 0 <= a < math.pi / 2:
+        raise ValueError(f"mu not given: body id {bid}'s material has frictionAngle = {a!r} rad, outside [0, pi/2); pass mu")
+    return math.tan(a)
 
 
 def _yade_body(i):
     """O.bodies[i] for a registrable id: it must exist and not be a clump member (pass the clump)."""
     from yade import O
-    if not isinstance(i, (int, np.integer)) or i < 0 or i >= len(O.bodies) or O.bodies[int(i)] is None:
+    if i < 0 or i >= len(O.bodies) or O.bodies[i] is None:
         raise ValueError(f"body id {i!r} does not exist in O.bodies")
-    b = O.bodies[int(i)]
+    b = O.bodies[i]
     if b.isClumpMember:
         raise ValueError(f"body id {i} is a member of clump {b.clumpId}; pass the clump id {b.clumpId}")
     return b
@@ -116,26 +174,27 @@ class RigidBodies:
         self.groups = []      # core group indices, one per add()
 
     # ------------------------------------------------------------------ set-up
-    def add(self, ids, mu=CONTACT_DEFAULTS["mu"], cohesion=CONTACT_DEFAULTS["cohesion"], chi=CONTACT_DEFAULTS["chi"],
-            d0=CONTACT_DEFAULTS["d0"], thickness=None):
-        """Register YADE bodies (an id or a list) as one contact group with friction coefficient mu [-],
-        cohesion [Pa], residual penetration factor chi [-] and detection distance d0 [m] (None: half the
-        particle edge; "initial": the first particle layer's distance to the body now, see the module
-        docstring); thickness [m] overrides the 2D z-extent. Returns the group index."""
-        _check_params(mu, cohesion, chi, d0, thickness)
-        ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
-        if not ids:
-            raise ValueError("ids: give at least one YADE body id")
+    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None):
+        """Register YADE bodies (an id or a list) as one contact group with friction coefficient mu [-]
+        (not given: tan(frictionAngle) of the bodies' YADE FrictMat; explicit values win), cohesion [Pa],
+        residual penetration factor chi [-] and detection distance d0 (None: half the particle edge; a number
+        [m] up to one grid spacing; "initial": the first particle layer's distance to the body now); ranges
+        and defaults: ``ym.ContactParams`` (module docstring). thickness [m] overrides the 2D z-extent.
+        Everything is checked before the solver changes. Returns the group index."""
+        ids = body_ids(ids)
+        check_thickness(thickness)
         bodies = []
         for i in ids:
             b = _yade_body(i)
-            if int(i) in self._part_of:
+            if i in self._part_of:
                 raise ValueError(f"body id {i} is already registered for contact")
             bodies.append(b)
+        prm = contact_params(friction_of(bodies) if mu is None else mu, cohesion, chi, d0)
+        prm.validateFor(self.solver.spacing)
         prims = [self._primitives(b) for b in bodies]   # validates shapes before touching the solver
         s = self.solver
         parts = [s.addRigidPart() for _ in bodies]
-        g = s.addContactGroup(parts, float(mu), float(cohesion), float(chi), d0 if d0 is None or isinstance(d0, str) else float(d0))
+        g = s.addContactGroup(parts, prm)
         for b, part, (plist, t) in zip(bodies, parts, prims):
             for kind, args in plist:
                 getattr(s, kind)(g, part, *args)

@@ -33,7 +33,7 @@ from . import _core
 from .engine import MpmEngine, _registry as _engines
 from .fields import SYM_NAMES, dim_of
 
-FORMAT = 3   # 3: named material options as words; 2: solver settings as Solver.settings() in the header (1: a hand-written list)
+FORMAT = 4   # 4: contact parameters (ContactParams.toDict) in the scene fingerprint; 3: named material options as words; 2: solver settings as Solver.settings() in the header (1: a hand-written list)
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
 
@@ -94,8 +94,8 @@ def _digest(*arrays):
 
 def solver_fingerprint(solver):
     """What makes a solver's scene this scene and not another: dimension, grid, particle count, the
-    particles' masses, initial volumes and surface loads (in id order), the material. These never
-    change while stepping, so a freshly built scene and a checkpoint of it mid-run agree on them."""
+    particles' masses, initial volumes and surface loads (in id order), the materials, the contact groups'
+    parameters. These never change while stepping, so a freshly built scene and a checkpoint of it mid-run agree on them."""
     arrs = _particle_arrays(solver)
     order = np.argsort(arrs["id"], kind="stable")
     loads = [arrs[f"trac{a}"][order] for a in range(dim_of(solver)) if f"trac{a}" in arrs]
@@ -105,6 +105,7 @@ def solver_fingerprint(solver):
             "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
             "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver.materialKinds],
             "materials": [solver.material(i).toDict() for i in range(solver.numMaterials)],
+            "contact": [solver.contactParams(g).toDict() for g in range(solver.numContactGroups)],   # ContactParams.hpp
             "material_index": _digest(arrs["material"][order])}
 
 

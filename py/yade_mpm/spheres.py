@@ -1,7 +1,9 @@
 """DEM spheres and clumps of spheres touching MPM particles, two-way, through the same PTS contact law
 as the rigid bodies of ``bodies.py`` (paper Sec. 2.3, Eqs. 23–26; pkg-mpm/PtsContact.hpp):
 
-    sp = ym.DemSpheres(solver, mu=0.3)                 # every free sphere and sphere clump in O.bodies
+    sp = ym.DemSpheres(solver)
+    sp.add("all", mu=0.3)                              # every free sphere and sphere clump in O.bodies
+    sp.add([s1, s2], chi=0.2)                          # or given ids: one call per set of contact parameters
     O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
                  InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
                                  [Law2_ScGeom_FrictPhys_CundallStrack()]),     # sphere–sphere, YADE's own
@@ -31,16 +33,19 @@ thickness t (default: its z-extent, 2R for a sphere at z = 0; or ``thickness``),
 ``bodies.py``: a sphere of YADE mass m moves like a disc of m/t per metre. 2D spheres must stay in the
 plane (``blockedDOFs = 'zXY'``); the trace is taken at registration.
 
-Contact parameters (mu, cohesion, chi, d0, thickness) as in ``bodies.py`` (same validation; d0 = "initial",
-for a body filling a domain at registration, is refused here).
+Contact parameters: the keywords of ``RigidBodies.add`` (mu, cohesion, chi, d0, thickness; one
+``ym.ContactParams`` declaration, see bodies.py): mu not given = tan(frictionAngle) of each body's YADE
+FrictMat (a clump: its members'); d0 = "initial", for a body filling a domain at registration, is
+refused here.
 """
 import functools
 import math
+import numbers
 import time
 
 import numpy as np
 
-from .bodies import CONTACT_DEFAULTS, _check_params, _rot, _vec, _yade_body, body_inertia
+from .bodies import _rot, _vec, _yade_body, body_ids, body_inertia, check_thickness, contact_params, friction_of
 from .scene import dim_of
 
 
@@ -59,46 +64,65 @@ def _timed(method):
 class DemSpheres:
     """YADE spheres / sphere clumps in two-way PTS contact with one solver's particles (module doc)."""
 
-    def __init__(self, solver, ids=None, mu=CONTACT_DEFAULTS["mu"], cohesion=CONTACT_DEFAULTS["cohesion"],
-                 chi=CONTACT_DEFAULTS["chi"], d0=CONTACT_DEFAULTS["d0"], thickness=None, max_check_steps=200):
-        """ids: YADE ids of spheres and clumps (None: every sphere that is not a clump member and every
-        clump of spheres in O.bodies); mu [-], cohesion [Pa], chi [-], d0 [m] or None, thickness [m] or
-        None (2D: the body's z-extent); max_check_steps: longest interval between broad-phase checks."""
-        from yade import O
-        _check_params(mu, cohesion, chi, d0, thickness)
-        if isinstance(d0, str):
-            raise ValueError(f"d0 = {d0!r}: DemSpheres takes a number >= 0 [m] or None (half the particle edge); "
-                             "'initial' is for RigidBodies (a body filling a domain at registration)")
-        if int(max_check_steps) != max_check_steps or max_check_steps < 1:
+    def __init__(self, solver, max_check_steps=200):
+        """max_check_steps: longest interval between broad-phase checks [steps], an integer ≥ 1. Bodies come
+        with ``add``."""
+        if not (isinstance(max_check_steps, numbers.Integral) and not isinstance(max_check_steps, bool) and max_check_steps >= 1):
             raise ValueError(f"max_check_steps = {max_check_steps!r} must be an integer ≥ 1")
         self.solver, self.dim = solver, dim_of(solver)
-        if ids is None:
-            ids = [b.id for b in O.bodies if b is not None and not b.isClumpMember and self._kind(b) is not None]
-        ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
-        if not ids:
-            raise ValueError("ids: no sphere or clump of spheres to register")
-        s, d = solver, self.dim
+        self.ids = np.empty(0, np.int64)
+        self.parts = np.empty(0, np.int64)
+        self.groups = np.empty(0, np.int64)
+        self.bound = np.empty(0)        # bounding radius about the body's centre [m]
+        self.thick = np.empty(0)        # 2D thickness t [m] (1 in 3D)
+        self.is_clump = np.zeros(0, bool)
+        self.active = np.zeros(0, bool)
+        self._R0 = {}                   # clump index -> orientation at registration
+        self.max_check_steps = int(max_check_steps)
+        self._next_check = 0            # solver step of the next broad-phase check
+        self.checks = 0                 # broad-phase checks made (for the benchmark)
+        self.wall = 0.0                 # wall seconds spent in read() and write() (Python side of the coupling)
+        self._newton = None
+
+    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None):
+        """Register YADE spheres and clumps of spheres (an id, a list, or "all": every sphere that is not a
+        clump member and every clump of spheres in O.bodies not registered yet), each its own contact group,
+        with the keywords of ``RigidBodies.add`` (mu not given: tan(frictionAngle) of each body's FrictMat;
+        d0 "initial" refused). Everything is checked before the solver changes. Returns the group indices."""
+        from yade import O
+        if isinstance(d0, str) and d0 == "initial":
+            raise ValueError(f"d0 = {d0!r}: DemSpheres takes a number [m] or None (half the particle edge); "
+                             "'initial' is for RigidBodies (a body filling a domain at registration)")
+        check_thickness(thickness)
+        known = set(self.ids.tolist())
+        if isinstance(ids, str) and ids == "all":
+            ids = [b.id for b in O.bodies if b is not None and not b.isClumpMember and self._kind(b) is not None
+                   and b.id not in known]
+            if not ids:
+                raise ValueError("ids = 'all': no sphere or clump of spheres to register")
+        ids = body_ids(ids)
+        s, d = self.solver, self.dim
         rows = []
         for i in ids:
             b = _yade_body(i)
+            if i in known:
+                raise ValueError(f"body id {i} is already registered for contact")
             kind = self._kind(b)
             if kind is None:
                 raise ValueError(f"body id {i} has shape {type(b.shape).__name__}; DemSpheres takes spheres and clumps of "
                                  "spheres (use yade_mpm.RigidBodies for boxes, walls, facets)")
-            rows.append((b, self._members(b, kind)))
-        self.ids = np.array([b.id for b, _ in rows], dtype=np.int64)
-        if len(set(self.ids.tolist())) != len(self.ids):
-            raise ValueError("ids: a body is listed twice")
-        n = len(rows)
-        self.parts = np.empty(n, np.int64)
-        self.groups = np.empty(n, np.int64)
-        self.bound = np.empty(n)        # bounding radius about the body's centre [m]
-        self.thick = np.empty(n)        # 2D thickness t [m] (1 in 3D)
-        self.is_clump = np.zeros(n, bool)
-        self._R0 = {}                   # clump index -> orientation at registration
-        for k, (b, (members, zext, brad)) in enumerate(rows):
+            prm = contact_params(friction_of([b]) if mu is None else mu, cohesion, chi, d0)
+            prm.validateFor(s.spacing)
+            rows.append((b, self._members(b, kind), prm))
+        n0, n = len(self.ids), len(rows)
+        grow = lambda a, fill: np.concatenate([a, np.full(n, fill, a.dtype)])   # noqa: E731
+        self.ids = np.concatenate([self.ids, np.array(ids, np.int64)])
+        self.parts, self.groups = grow(self.parts, -1), grow(self.groups, -1)
+        self.bound, self.thick = grow(self.bound, 0.0), grow(self.thick, 1.0)
+        self.is_clump, self.active = grow(self.is_clump, False), grow(self.active, False)
+        for k, (b, (members, zext, brad), prm) in enumerate(rows, start=n0):
             part = s.addRigidPart()
-            g = s.addContactGroup([part], float(mu), float(cohesion), float(chi), None if d0 is None else float(d0))
+            g = s.addContactGroup([part], prm)
             for cL, r in members:
                 s.addContactSphere(g, part, tuple(cL[:d]), float(r))
             self.parts[k], self.groups[k], self.bound[k] = part, g, brad
@@ -106,13 +130,9 @@ class DemSpheres:
             self.is_clump[k] = type(b.shape).__name__ == "Clump"
             if self.is_clump[k]:
                 self._R0[k] = _rot(b.state.ori)
-        s.setContactGroupsEnabled(self.groups, False)
-        self.active = np.zeros(n, bool)
-        self.max_check_steps = int(max_check_steps)
-        self._next_check = 0            # solver step of the next broad-phase check
-        self.checks = 0                 # broad-phase checks made (for the benchmark)
-        self.wall = 0.0                 # wall seconds spent in read() and write() (Python side of the coupling)
-        self._newton = None
+        s.setContactGroupsEnabled(self.groups[n0:], False)
+        self._next_check = 0            # the new bodies get a broad-phase check at the next read()
+        return self.groups[n0:].tolist()
 
     # ------------------------------------------------------------------ set-up helpers
     @staticmethod
@@ -199,6 +219,8 @@ class DemSpheres:
         """Before the MPM step: broad phase when due, then the kinematics of the active bodies."""
         from yade import O
         s, d = self.solver, self.dim
+        if not len(self.ids):
+            return
         if s.steps >= self._next_check:
             self._broad_phase()
         k = np.nonzero(self.active)[0]

@@ -1,0 +1,51 @@
+// The contact parameters of one contact group (paper Sec. 2.3, Eqs. 23–26), each declared once (columns:
+// ParamTable.hpp). The fields, the range checks, the Python class ym.ContactParams (properties with unit
+// and range, keyword constructor, toDict/fromDict for checkpoints), the registration keywords of
+// ym.RigidBodies/ym.DemSpheres and the tables of doc/contact.md all come from this list.
+#pragma once
+#include "ParamTable.hpp"
+
+// X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
+// chi default ½: positions advance with the updated velocity (x += Δt v^{n+1}), so (1 − χ) κ = m/Δt² takes a
+// penetrating particle back to d0 in exactly one step; χ = 0 pushes it out by twice its penetration (the
+// contact layer is reflected; measured +15 % total energy at the first contact of a 3D block dropped on a wall).
+// autoD0: ½ V_p^{1/D} is half the particle's edge, i.e. contact when the particle's face touches.
+// initialD0: the paper's d0 is "the initial distance of particle used for the contact detection" (text after
+// Eq. 26); the first lattice layer next to the surface at registration gets d0_p = d_p(0) (a body filling a
+// domain, e.g. a flaw filler, touches the material around it at zero force from t = 0), every other particle
+// keeps the autoD0/d0 value. First layer: d_p(0) < e_p max_i |n_i| (ContactGroups::captureInitialD0).
+#define MPM_CONTACT_PARAMS(X)                                                                                                     \
+	X(Real, mu, 0, "-", 0, INFINITY, CO, "μ_con",                                                                                \
+	  "Coulomb friction coefficient of the contact (ym.RigidBodies/DemSpheres.add without mu: tan(frictionAngle) of the "     \
+	  "body's YADE FrictMat)", "Eq. 24", "")                                                                                     \
+	X(Real, cohesion, 0, "Pa", 0, INFINITY, CO, "c_con", "contact cohesion (tangential capacity per contact area)", "Eq. 24", "") \
+	X(Real, chi, 0.5, "-", 0, 1, CO, "χ",                                                                                        \
+	  "residual penetration factor: the normal penalty is (1 − χ) κ_p (d0 − d_p), κ_p = 2 m_p/Δt²", "Eq. 23", "")               \
+	X(Real, d0, 0, "m", 0, INFINITY, CO, "d0",                                                                                   \
+	  "detection distance when autoD0 is off; at most one grid spacing (checked when the group is added)", "Eq. 23", "")       \
+	X(bool, autoD0, true, "-", 0, 1, CC, "", "d0 = ½ V_p^{1/D}, half the particle's own edge (registration keyword d0=None)",  \
+	  "Eq. 23", "")                                                                                                              \
+	X(bool, initialD0, false, "-", 0, 1, CC, "",                                                                                 \
+	  "the first particle layer next to the body at registration gets d0 = its initial distance (registration keyword "         \
+	  "d0='initial')", "Eq. 23, text after Eq. 26", "")
+
+namespace mpm {
+
+struct ContactParams {
+	MPM_PARAMS(ContactParams, NoParams, MPM_CONTACT_PARAMS) // μ, c, χ, d0, autoD0, initialD0
+
+	// The table's ranges. d0 beyond one cell is refused where the grid is known (validateFor).
+	void validate() const { validateParams(); }
+	// With the grid spacing l [m]: a fixed d0 is at most l (the contact acts at the particles' surface; a
+	// larger detection distance pushes material that is cells away from the body).
+	void validateFor(Real l) const
+	{
+		validate();
+		if (!autoD0 && d0 > l)
+			throw InputError("d0 = " + ParamInfo::num(d0) + " [m] is outside the allowed range [0, " + ParamInfo::num(l)
+			                 + "] (at most one grid spacing; None = half the particle edge)");
+	}
+};
+static_assert(std::is_trivially_copyable_v<ContactParams>, "contact parameters must stay plain data");
+
+} // namespace mpm
