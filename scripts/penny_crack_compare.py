@@ -1,6 +1,6 @@
 """Compare line-crack damage runs of scripts/penny_crack.py with the paper's Fig. 9.
 
-Reads `crack_extension_law<N>.csv` and `summary.json` of each run directory and writes
+Reads `crack_extension_<growth law>.csv` and `summary.json` of each run directory and writes
   <out>.csv   one row per run: Δa at t_paper = 0.05, 0.1, 0.2, 0.3, 0.4 s in cells of the paper's grid
               (0.02 m; runs on other grids are converted through their spacing), initiation time,
               deviation from 7 / 22 / 72 cells (RMS, largest), wall time;

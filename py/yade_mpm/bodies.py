@@ -122,6 +122,14 @@ def friction_of(bodies):
     return math.tan(a)
 
 
+def check_state(b):
+    """A body's position [m] and velocity [m/s] must be finite (a DEM sphere at a NaN position was registered
+    and never touched anything)."""
+    for name, v, unit in (("pos", b.state.pos, "m"), ("vel", b.state.vel, "m/s")):
+        if not all(math.isfinite(x) for x in v):
+            raise ValueError(f"body id {b.id}: state.{name} = ({', '.join(repr(float(x)) for x in v)}) [{unit}] must be finite")
+
+
 def _yade_body(i):
     """O.bodies[i] for a registrable id: it must exist and not be a clump member (pass the clump)."""
     from yade import O
@@ -188,6 +196,7 @@ class RigidBodies:
             b = _yade_body(i)
             if i in self._part_of:
                 raise ValueError(f"body id {i} is already registered for contact")
+            check_state(b)
             bodies.append(b)
         prm = contact_params(friction_of(bodies) if mu is None else mu, cohesion, chi, d0)
         prm.validateFor(self.solver.spacing)

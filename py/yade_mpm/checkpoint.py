@@ -13,8 +13,8 @@ them and the solver settings (``Solver.settings()``); with YADE also the scene w
 the body states once more (checked bitwise after ``O.load``) and the ``MpmEngine`` state. A resumed run
 is bitwise identical to the uninterrupted one for the same thread count. The script builds the scene
 as usual and ``load`` overwrites its state, after checking the whole file: a truncated or corrupted
-file, another format or build of the core, or another scene (grid, particles, materials, loads, YADE
-bodies and engines) is refused with a ``CheckpointError`` (a ``ValueError``), nothing changed. The
+file, another format or build of the core, or another scene (grid, particles, materials, loads, contact
+parameters, YADE bodies and engines) is refused with a ``CheckpointError`` (a ``ValueError``), nothing changed. The
 ``MpmEngine`` registry is restored after ``O.load`` (doc/checkpoint.md). The run-loop side, periodic
 checkpoints and clean stops on SIGINT / SIGTERM, is ``Checkpointer`` and ``ResumableRun`` in
 ``yade_mpm.resumable``.
@@ -33,7 +33,9 @@ from . import _core
 from .engine import MpmEngine, _registry as _engines
 from .fields import SYM_NAMES, dim_of
 
-FORMAT = 4   # 4: contact parameters (ContactParams.toDict) in the scene fingerprint; 3: named material options as words; 2: solver settings as Solver.settings() in the header (1: a hand-written list)
+# 4: contact parameters (ContactParams.toDict) in the fingerprint; 3: named material options as words;
+# 2: solver settings as Solver.settings() in the header (1: a hand-written list)
+FORMAT = 4
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
 
@@ -95,7 +97,7 @@ def _digest(*arrays):
 def solver_fingerprint(solver):
     """What makes a solver's scene this scene and not another: dimension, grid, particle count, the
     particles' masses, initial volumes and surface loads (in id order), the materials, the contact groups'
-    parameters. These never change while stepping, so a freshly built scene and a checkpoint of it mid-run agree on them."""
+    parameters. These never change while stepping: a fresh scene and a checkpoint of it mid-run agree."""
     arrs = _particle_arrays(solver)
     order = np.argsort(arrs["id"], kind="stable")
     loads = [arrs[f"trac{a}"][order] for a in range(dim_of(solver)) if f"trac{a}" in arrs]
@@ -150,22 +152,15 @@ def _restore_solver(solver, arrs, settings):
 
 # -------------------------------------------------------------------------------------- YADE state
 def _yade_O():
-    if "yade" not in sys.modules:
-        return None
-    from yade import O
-    return O
+    return sys.modules["yade"].O if "yade" in sys.modules else None
 
 
 def _body_state(O):
     """Body states as float64 arrays (to check bitwise after O.load)."""
     rows = []
     for b in O.bodies:
-        if b is None:
-            rows.append([np.nan] * 16)
-            continue
-        s = b.state
-        q = s.ori
-        rows.append(list(s.pos) + list(s.vel) + list(s.angVel) + [q[0], q[1], q[2], q[3]] + list(s.refPos))
+        s, q = (None, None) if b is None else (b.state, b.state.ori)
+        rows.append([np.nan] * 16 if s is None else list(s.pos) + list(s.vel) + list(s.angVel) + [q[0], q[1], q[2], q[3]] + list(s.refPos))
     return np.array(rows, dtype=np.float64).reshape(-1, 16)
 
 

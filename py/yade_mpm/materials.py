@@ -15,9 +15,30 @@ word) is an alias of ``dilationAngle`` (YADE's word, cf. ``JCFpmMat.jointDilatio
 """
 from ._core import ElasticMat, DpGkMat
 
-__all__ = ["ElasticMat", "DpGkMat", "describe"]
+__all__ = ["ElasticMat", "DpGkMat", "describe", "markdown_table"]
 
 
 def describe(cls):
     """Table of the parameters of a material class as text (name, unit, range, default, equation)."""
     return "\n".join(f"{p['name']:18s} {p['describe']}" for p in cls.paramTable())
+
+
+def markdown_table(cls):
+    """The parameter table of a class (materials, ``ContactParams``) as Markdown, as doc/ pastes it
+    (tests check the docs against it): name, symbol, unit, range or choices, default, meaning, equation."""
+    def rng(p):
+        if p["type"] == "bool":
+            return "True / False"
+        if p["type"] == "choice":
+            return " / ".join(f"'{w}'" for w in p["choices"])
+        def num(x):
+            return "inf" if x == float("inf") else "-inf" if x == -float("inf") else f"{x:g}"
+        return ("(" if p["loOpen"] else "[") + num(p["lo"]) + ", " + num(p["hi"]) + (")" if p["hiOpen"] else "]")
+
+    def default(p):
+        d = p["default"]
+        return "required" if d is None else repr(bool(d)) if p["type"] == "bool" else f"'{d}'" if p["type"] == "choice" else f"{d:g}"
+    rows = ["| name | symbol | unit | range | default | meaning | paper |", "|---|---|---|---|---|---|---|"]
+    rows += [f"| `{p['name']}` | {p['symbol']} | {p['unit']} | {rng(p)} | {default(p)} | {p['doc']} | {p['eq']} |"
+             for p in cls.paramTable()]
+    return "\n".join(rows)

@@ -45,7 +45,7 @@ import time
 
 import numpy as np
 
-from .bodies import _rot, _vec, _yade_body, body_ids, body_inertia, check_thickness, contact_params, friction_of
+from .bodies import _rot, _vec, _yade_body, body_ids, body_inertia, check_state, check_thickness, contact_params, friction_of
 from .scene import dim_of
 
 
@@ -107,6 +107,7 @@ class DemSpheres:
             b = _yade_body(i)
             if i in known:
                 raise ValueError(f"body id {i} is already registered for contact")
+            check_state(b)
             kind = self._kind(b)
             if kind is None:
                 raise ValueError(f"body id {i} has shape {type(b.shape).__name__}; DemSpheres takes spheres and clumps of "
@@ -186,6 +187,9 @@ class DemSpheres:
         st = [O.bodies[int(i)].state for i in self.ids]
         x = np.array([[q.pos[a] for a in range(d)] for q in st])
         v = np.array([[q.vel[a] for a in range(d)] for q in st])
+        bad = ~(np.isfinite(x).all(axis=1) & np.isfinite(v).all(axis=1))
+        if bad.any():                                  # a NaN gap would leave the body inactive, silently
+            check_state(O.bodies[int(self.ids[np.argmax(bad)])])
         lo = np.array([s.view(f"x{a}").min() for a in range(d)])
         hi = np.array([s.view(f"x{a}").max() for a in range(d)])
         reach = 2.0 * s.spacing
