@@ -12,11 +12,10 @@ tunnel_spalling.py's curve, which averages over 0.01 mm). One JSON line `RESULT 
 --csv FILE it is also appended as a row. Scene, rock and filler come from yade_mpm.cases / rocks."""
 import argparse
 import json
-import math
 import os
 import time
 
-from yade_mpm import cases, rocks, runner
+from yade_mpm import ContactParams, cases, rocks, runner
 
 MARKS_MM = (0.25, 0.5, 0.75, 1.0, 1.5, 2.0)
 ROCKS = ("dpgk", "dp", "elastic")
@@ -28,7 +27,7 @@ def parse():
     ap.add_argument("--rock", default="dpgk", help="dpgk = rocks.pan2020_sandstone() (default), dp = the same without damage, "
                     "elastic = its E, ν, ρ only")
     ap.add_argument("--filler-friction", type=float, default=cases.FILLER_FRICTION,
-                    help=f"μ_con of the rigid filler [-], >= 0 (default {cases.FILLER_FRICTION})")
+                    help=f"μ_con of the rigid filler [-] (ContactParams.mu; default {cases.FILLER_FRICTION})")
     ap.add_argument("--spacing", type=float, default=0.002, help="grid spacing l [m] (default 0.002; paper 0.001)")
     ap.add_argument("--end-time", type=float, default=0.01, help="loading time [s], (0, 0.02] (default 0.01 = 1 mm)")
     ap.add_argument("--csv", default=None, help="append the result as a row of this CSV file")
@@ -37,8 +36,10 @@ def parse():
         ap.error(f"--case {a.case!r} must be one of {cases.TUNNEL_CASES}")
     if a.rock not in ROCKS:
         ap.error(f"--rock {a.rock!r} must be one of {ROCKS}")
-    if not (math.isfinite(a.filler_friction) and a.filler_friction >= 0):
-        ap.error(f"--filler-friction {a.filler_friction!r} must be a finite number >= 0")
+    try:
+        ContactParams(mu=a.filler_friction)            # the range is declared once (pkg-mpm/ContactParams.hpp)
+    except ValueError as e:
+        ap.error(f"--filler-friction: {e}")
     if not (0 < a.end_time <= cases.TUNNEL_END_TIME):
         ap.error(f"--end-time {a.end_time!r} s must be in (0, {cases.TUNNEL_END_TIME}]")
     return a
