@@ -22,6 +22,7 @@ nearest-row mean is reported too. Default: L = 4.8 m, l = 0.04 m, convergence ta
 
     /usr/bin/python3 scripts/circular_opening.py --out out/circular_opening             # default
     /usr/bin/python3 scripts/circular_opening.py --out out/co_paper --spacing 0.01 --domain 5 --no-convergence
+    yade-batch scripts/circular_opening.table scripts/circular_opening.py   # a study: one run per line (doc/studies.md)
 """
 import argparse
 import math
@@ -35,7 +36,7 @@ import yade_mpm as ym
 import yade_mpm.output as out
 from yade_mpm.validation import kirsch
 
-from yade_mpm import cases, rocks, runner
+from yade_mpm import batch, cases, rocks, runner
 from yade_mpm.cases import OPENING_CENTER as CENTER, OPENING_RADIUS as RADIUS, OPENING_SXX as SXX_FAR, OPENING_SYY as SYY_FAR
 
 MPa = 1e6
@@ -68,7 +69,7 @@ def parse_args(argv=None):
     p.add_argument("--vtu-every", type=float, default=0.0,
                    help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "
                         "many simulated seconds [s] (default 0: final state only)")
-    a = p.parse_args(argv)
+    a = batch.parse_args(p, argv)     # the command line, or a yade-batch / scripts/sweep.py table line
     check_args(a)
     return a
 
@@ -344,13 +345,14 @@ def main(argv=None):
                                    hoop_stress_theta0_MPa=r["hoop_stress_theta0_MPa"],
                                    hoop_stress_theta90_MPa=r["hoop_stress_theta90_MPa"]) for r in table]
     out.write_summary(args.out, summary)
+    batch.write_summary(args.out, [dict(spacing_m=args.spacing, domain_m=args.domain, ppc=args.ppc, damping=args.damping,   # a study's row
+                                        boundary_load=args.boundary_load, tol=args.tol, **{k: main_res[k] for k in ROW_KEYS})])
     print(f"[circular_opening] wrote {args.out}/summary.json", flush=True)
     return summary
 
 
+ROW_KEYS = ("particles", "steps", "simulated_time_s", "converged", "l2_rel_error_max", "l2_rel_error_near_max",
+            "hoop_stress_theta0_MPa", "hoop_stress_theta90_MPa")
+
 if __name__ == "__main__":
-    try:
-        main()
-    except ValueError as e:
-        print(f"circular_opening.py: error: {e}", file=sys.stderr)
-        sys.exit(2)
+    batch.main(main)                  # bad input: one line "circular_opening.py: error: …", exit status 2

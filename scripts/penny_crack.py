@@ -22,6 +22,7 @@ P(t)). `--full` runs the paper's 0.5 s ramp (hours). summary.json says which con
 
     /usr/bin/python3 scripts/penny_crack.py --out out/penny            # default
     /usr/bin/python3 scripts/penny_crack.py --out out/penny --full     # paper time scale
+    yade-batch scripts/penny_crack.table scripts/penny_crack.py   # a study: one run per line (doc/studies.md)
 """
 import argparse
 import math
@@ -36,7 +37,7 @@ import yade_mpm.output as out
 from yade_mpm.validation import sneddon
 from yade_mpm.validation.line_crack import PAPER_CELL, PAPER_DA, crack_extension, interp_da, paper_comparison
 
-from yade_mpm import cases, rocks, runner
+from yade_mpm import batch, cases, rocks, runner
 
 ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
 HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
@@ -290,7 +291,7 @@ def main(argv=None):
     ap.add_argument("--vtu", action="store_true", help="also write VTU particle files of the damage snapshots")
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
     ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
-    a = ap.parse_args(argv)
+    a = batch.parse_args(ap, argv)    # the command line, or a yade-batch / scripts/sweep.py table line
     parts = set(a.parts.split(","))
     if not parts <= {"elastic", "convergence", "damage"}:
         ap.error(f"--parts: unknown part in {a.parts}; allowed elastic, convergence, damage")
@@ -391,8 +392,21 @@ def main(argv=None):
             merged["particles"] = max(particles, prev.get("particles", 0))
             summary = merged
     out.write_summary(a.out, summary)
+    batch.write_summary(a.out, [study_row(a, parts, summary)])
     return summary
 
 
+def study_row(a, parts, s):
+    """This invocation's row of OUT/summary.csv (a study's line, scripts/study_report.py): parameters and results, no wall time."""
+    row = dict(parts="+".join(sorted(parts)), size_m=a.size, spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
+               damage_pressure_MPa=a.damage_pressure / 1e6, ramp_time_s=a.ramp_time, end_time_s=a.end_time, laws=a.laws,
+               edges=a.edges, edge_set=a.edge_set, threshold_volume=s["config"]["threshold_volume"], flaws=a.flaws, flaw_seed=a.flaw_seed,
+               uy_center_rel_error=s.get("uy_center_rel_error"), uy_l2_rel_error=s.get("uy_l2_rel_error"),
+               syy_ahead_l2_rel_error=s.get("syy_ahead_l2_rel_error"), plastic_particles=s.get("plastic_particles"))
+    for d in s.get("crack_extension_cells", []) if "damage" in parts else []:
+        row[f"crack_extension_cells_left_t{d['t_s']:g}"], row[f"crack_extension_cells_right_t{d['t_s']:g}"] = d["left"], d["right"]
+    return row
+
+
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    batch.main(lambda: main(sys.argv[1:]))

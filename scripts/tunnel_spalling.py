@@ -19,13 +19,14 @@ Ctrl-C / SIGTERM: writes a last checkpoint and the outputs so far, then stops (-
 """
 import argparse
 import json
+import math
 import os
 import sys
 
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import analysis, cases, output, resumable, runner
+from yade_mpm import analysis, batch, cases, output, resumable, rocks, runner
 
 SNAPSHOTS_MS = (8.0, 12.0, 20.0)          # field pictures (Figs. 18a–c, 19)
 CURVE_STEP_MM = 0.1                       # summary.json: axial stress every 0.1 mm
@@ -51,7 +52,10 @@ def parse():
                     help="checkpoint period: N (steps) or Nmin (wall minutes); 0 = only at the end/interrupt (default 5min)")
     ap.add_argument("--resume", action="store_true", help="continue unfinished cases from OUT/CASE/checkpoint.ckpt; keep finished ones")
     ap.add_argument("--progress", type=float, default=15.0, help="wall seconds between progress lines (default 15)")
-    a = ap.parse_args()
+    ap.add_argument("--flaw-angle", type=float, default=cases.FLAW_ANGLE_DEG, help="flaw inclination about its toe [°] (default %(default)s)")
+    ap.add_argument("--filler-mu", type=float, default=cases.FILLER_FRICTION, help="filler–rock friction μ_con of filled_flaw (default %(default)s)")
+    ap.add_argument("--grout-young", type=float, default=rocks.CEMENT_GROUT["young"], help="grout E of grout_flaw [Pa] (default %(default)s)")
+    a = batch.parse_args(ap)                  # the command line, or a yade-batch / scripts/sweep.py table line
     a.cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     bad = [c for c in a.cases if c not in cases.TUNNEL_CASES]
     if bad or not a.cases:
@@ -82,7 +86,8 @@ class CaseRun:
     def __init__(self, case, args):
         self.case, self.args = case, args
         self.dir = os.path.join(args.out, case)
-        self.solver, self.bodies = cases.arch_tunnel(case, args.spacing)
+        self.solver, self.bodies = cases.arch_tunnel(case, args.spacing, filler_friction=args.filler_mu, flaw_angle=math.radians(args.flaw_angle),
+                                                     grout=rocks.cement_grout(young=args.grout_young))
         s = self.solver
         s.courant = args.courant
         self.flaw = self.bodies["flaw"]
@@ -92,7 +97,8 @@ class CaseRun:
         self.rock = ym.get(s, "material") == 0                 # rock, not grout (material 0 of the scene)
         self.job = resumable.ResumableRun(s, self.dir, state=dict(first_crack=None, snapshots=[]), every_steps=args.ck_steps,
                                           every_minutes=args.ck_minutes, engine=self.bodies["engine"],
-                                          meta={"case": case, "spacing": args.spacing, "courant": args.courant})
+                                          meta={"case": case, "spacing": args.spacing, "courant": args.courant, "flaw_angle": args.flaw_angle,
+                                                "filler_mu": args.filler_mu, "grout_young": args.grout_young})
         self.failed, self.interrupted = None, False
 
     state = property(lambda self: self.job.state)             # the record: checkpointed, state.json at the end
@@ -288,6 +294,8 @@ def main():
     if o:
         txt.append(f"Fig. 17 ordering open_flaw < intact < filled_flaw holds at {o['holds']} of {o['samples']} displacements (0.1 mm apart)")
     open(os.path.join(a.out, "summary.txt"), "w").write("\n\n".join(txt) + "\n")
+    if not failed and all(r.state["done"] for r in runs) and len(runs) == len(a.cases):
+        batch.write_summary(a.out, [study_row(r, e, a) for r, e in zip(runs, entries)])   # a study's rows: one per case
     print("\n\n".join(txt))
     print(f"results in {os.path.abspath(a.out)}")
     if failed:
@@ -295,5 +303,24 @@ def main():
         sys.exit(1)
 
 
+def study_row(r, e, a):
+    """The case's row of OUT/summary.csv (a study's line, scripts/study_report.py): parameters and results, no wall time."""
+    at = {p["displacement_mm"]: p["stress_MPa"] for p in e["axial_stress_MPa_at"]}
+    c = np.array(r.state["curve"])
+    k = int(np.argmax(c[:, 2]))
+    last = r.result["snapshots"][max(r.result["snapshots"])] if r.result["snapshots"] else {}
+    fc = r.state["first_crack"]
+    return dict(case=r.case, spacing_m=a.spacing, end_time_s=a.end_time, courant=a.courant,
+                flaw_angle_deg=a.flaw_angle if r.case != "intact" else None,
+                filler_mu=a.filler_mu if r.case == "filled_flaw" else None,
+                grout_young_GPa=a.grout_young / 1e9 if r.case == "grout_flaw" else None,
+                particles=e["particles"], steps=e["steps"], final_displacement_mm=e["final_displacement_mm"],
+                **{f"stress_MPa_at_{d:g}mm": at.get(d) for d in (0.5, 1.0, 1.5, 2.0)},
+                peak_stress_MPa=float(c[k, 2] / 1e6), displacement_at_peak_mm=float(c[k, 1] * 1e3),
+                first_damage_mm=fc["displacement"] * 1e3 if fc else None, first_damage_at=fc["location"] if fc else None,
+                spalled_area_mm2=last.get("spalled_area_mm2"), damaged_fraction=last.get("damaged_fraction"),
+                softened_fraction=last.get("softened_fraction"), spalling_at=last.get("spalling_at"))
+
+
 if __name__ == "__main__":
-    main()
+    batch.main(main)

@@ -13,7 +13,10 @@ sigma_max_open_vs_filled.png.
 
     PYTHONPATH=py /usr/bin/python3 scripts/uniaxial_flaw.py [--out DIR] [--paper | --spacing L]
         [--runs intact,open,filled:0.4:0] [--end-time T] [--summary-only]
-    yade-batch scripts/uniaxial_flaw.table scripts/uniaxial_flaw.py    # one job per row, same OUT
+    yade-batch scripts/uniaxial_flaw.table scripts/uniaxial_flaw.py    # one job per line, OUT/<description>/
+    /usr/bin/python3 scripts/sweep.py scripts/uniaxial_flaw.table scripts/uniaxial_flaw.py   # the same on Dask
+
+Each invocation also writes OUT/summary.csv, one row per run (doc/studies.md).
 """
 import argparse
 import glob
@@ -26,7 +29,7 @@ import time
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import analysis, cases, output, runner
+from yade_mpm import analysis, batch, cases, output, runner
 
 DEFAULT_SPACING = 2.0e-3       # coarse default grid [m]: the whole set in < 15 min on 2 idle cores
 END_TIME = 0.014               # simulated loading time [s] (1.4 mm of platen travel); runs stop earlier once softened
@@ -68,10 +71,11 @@ def parse(argv=None):
     p.add_argument("--runs", default=None, help="subset, e.g. intact,open,filled:0.4:0 (variant:mu_con:c_con_MPa)")
     p.add_argument("--vtu-every", type=float, default=1e-3, help="VTU period [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=30.0, help="wall seconds between progress lines")
-    p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json into the summary")
+    p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json (and a study's OUT/*/runs/*/run.json) "
+                   "into the summary")
     p.add_argument("--filler-blocked-dofs", default="zXY", help="blockedDOFs of the filler (default %(default)s: free in the "
                    "plane; zXYZ: no rotation)")
-    a = p.parse_args(argv)
+    a = batch.parse_args(p, argv)     # the command line, or a yade-batch / scripts/sweep.py table line
     if a.paper and a.spacing is not None:
         p.error("--paper and --spacing exclude each other")
     a.spacing = cases.UNIAXIAL_PAPER_SPACING if a.paper else (a.spacing or DEFAULT_SPACING)
@@ -144,7 +148,7 @@ def one_run(variant, mu, c_mpa, a):
 # ------------------------------------------------------------------------------------------------ summary
 def load_runs(out):
     runs = []
-    for f in sorted(glob.glob(os.path.join(out, "runs", "*", "run.json"))):
+    for f in sorted(glob.glob(os.path.join(out, "runs", "*", "run.json")) + glob.glob(os.path.join(out, "*", "runs", "*", "run.json"))):
         with open(f) as fh:
             e = json.load(fh)
         e["dir"] = os.path.dirname(f)
@@ -290,25 +294,20 @@ def summarize(out):
     return summary
 
 
+ROW_KEYS = ("variant", "mu_con", "c_con_MPa", "spacing_m", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s",
+            "youngs_modulus_GPa", "particles", "steps", "end_reason", "softened", "damaged_fraction_end")
+
+
 def main(argv=None):
-    table = os.environ.get("YADE_BATCH")
-    if table:                                      # a yade-batch job: one row of scripts/uniaxial_flaw.table
-        from yade import utils
-        utils.readParamsFromTable(variant="open", mu_con=0.0, c_con_MPa=0.0, out=DEFAULT_OUT, spacing=DEFAULT_SPACING,
-                                  noTableOk=True)
-        from yade.params import table as row
-        a = parse(["--out", row.out, "--spacing", str(row.spacing)])
-        one_run(row.variant, float(row.mu_con), float(row.c_con_MPa), a)
-        summarize(a.out)                           # rewritten after every job: the last one sees all
-        return
     a = parse(argv)
     if not a.summary_only:
         t0 = time.time()
-        for variant, mu, c in a.run_list:
-            one_run(variant, mu, c, a)
+        entries = [one_run(variant, mu, c, a) for variant, mu, c in a.run_list]
         print(f"all runs: {time.time() - t0:.0f} s wall")
     summarize(a.out)
+    if not a.summary_only:                         # a study's rows (scripts/study_report.py): no wall times
+        batch.write_summary(a.out, [dict({k: e[k] for k in ROW_KEYS}, end_time_s=a.end_time) for e in entries])
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    batch.main(lambda: main(sys.argv[1:]))

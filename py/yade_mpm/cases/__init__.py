@@ -19,7 +19,7 @@ from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING
                       circular_opening, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
 from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler,
                       yade_platen)
-from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_WIDTH, TUNNEL_CASES,
+from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_WIDTH, TUNNEL_CASES,
                      TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
                      arch_tunnel, arch_tunnel_holes, arch_tunnel_specimen, tunnel_flaw, tunnel_location,
                      tunnel_opening_distance, tunnel_report, tunnel_where)

@@ -60,7 +60,8 @@ def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floo
 # the left spandrel; a crack links the toe to the tunnel corner) — see doc/tunnel.md. One place only:
 FLAW_LENGTH = 0.06                 # [m]
 FLAW_WIDTH = 0.002                 # [m]
-FLAW_ANGLE = math.radians(60.0)    # inclination to the horizontal [rad]; rises to the left, away from the tunnel
+FLAW_ANGLE_DEG = 60.0              # inclination to the horizontal [°]; rises to the left, away from the tunnel
+FLAW_ANGLE = math.radians(FLAW_ANGLE_DEG)   # the same [rad]
 FLAW_TOE_GAP = 0.010               # horizontal rock bridge from the toe (lower end) to the left wall [m]
 FLAW_TOE = (TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - FLAW_TOE_GAP, TUNNEL_FLOOR + TUNNEL_RECT[1])  # at spandrel height [m]
 
@@ -83,8 +84,17 @@ def tunnel_flaw(toe=FLAW_TOE, length=FLAW_LENGTH, width=FLAW_WIDTH, angle=FLAW_A
                 polygon=rotated_rectangle(center, length, width, math.atan2(u[1], u[0])))
 
 
+def _flaw_clear(angle, spacing):
+    """Does the flaw at `angle` [rad] (default toe and size) keep one cell `spacing` of rock to every face and the opening?"""
+    f = tunnel_flaw(angle=angle)
+    u, n = f["direction"], f["normal"] * 0.5 * f["width"]
+    p = f["toe"] + np.linspace(0, f["length"], 41)[:, None] * u
+    p = np.vstack([p + n, p - n])
+    return bool(np.all((p >= spacing) & (p <= TUNNEL_WIDTH - spacing)) and np.all(tunnel_opening_distance(p) >= spacing))
+
+
 def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
-                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, label="mpm"):
+                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm"):
     """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
     arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
     DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
@@ -93,7 +103,8 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
            "filled_flaw"  the flaw cut out and filled by a free rigid YADE Box (PTS contact, μ = filler_friction),
            "grout_flaw"   the flaw filled with particles of the elastic `grout` (default ``rocks.cement_grout()``),
                           bonded to the rock through the shared grid.
-    spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``).
+    spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``);
+    flaw_angle: the flaw's inclination [rad] about its toe (FLAW_ANGLE; it must leave a cell of rock to every face).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
@@ -106,11 +117,17 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
         raise ValueError(f"spacing = {spacing!r} m must be in (0, {TUNNEL_MAX_SPACING}] m (the {FLAW_WIDTH * 1e3:g} mm flaw must "
                          "cut at least one full particle row, particle spacing l/2)")
     platen_speed = _number(platen_speed, "platen_speed", "m/s", positive=True)
+    flaw_angle = _number(flaw_angle, "flaw_angle", "rad")
+    if case != "intact" and not _flaw_clear(flaw_angle, spacing):
+        ok = [d for d in np.arange(0.0, 180.01, 0.5) if _flaw_clear(math.radians(d), spacing)] or [math.nan]
+        raise ValueError(f"flaw_angle = {math.degrees(flaw_angle):.6g}° puts the {FLAW_LENGTH * 1e3:g} mm flaw from its toe at "
+                         f"{FLAW_TOE[0] * 1e3:g}, {FLAW_TOE[1] * 1e3:g} mm within one cell of a face or of the opening; allowed at "
+                         f"l = {spacing * 1e3:g} mm: [{ok[0]:g}, {ok[-1]:g}]°")
     from yade import O
     from ..bodies import RigidBodies
 
     W = TUNNEL_WIDTH
-    flaw = tunnel_flaw() if case != "intact" else None
+    flaw = tunnel_flaw(angle=flaw_angle) if case != "intact" else None
     rock = material or rocks.pan2020_sandstone()
     holes = [flaw["polygon"]] if flaw is not None else []
     s = arch_tunnel_specimen(spacing, rock, ppc, holes=holes)
