@@ -165,8 +165,7 @@ def open_client(a):
         c = Client(a.scheduler, timeout=60)
         return c, None, f"cluster {a.scheduler}"
     n = a.workers or max(1, (os.cpu_count() or 1) // a.threads_per_run)
-    dask.config.set({"distributed.scheduler.allowed-failures": a.retries,    # a dead worker's line: failed (or retried)
-                     "distributed.scheduler.worker-saturation": 1.0})        # one line per worker at a time
+    dask.config.set({"distributed.scheduler.allowed-failures": a.retries})   # a dead worker's line: failed (or retried)
     old = signal.signal(signal.SIGINT, signal.SIG_IGN)   # the workers (and their runs) inherit it: a terminal's Ctrl-C
     try:                                                 # reaches only this process, which stops the runs in order
         cl = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None)
@@ -200,13 +199,20 @@ def main(argv=None):
         env = {"OMP_NUM_THREADS": str(a.threads_per_run), "DISPLAY": ""}
         if os.environ.get("PYTHONPATH"):
             env["PYTHONPATH"] = os.environ["PYTHONPATH"]
-        futs = {}
-        for ln in todo:
-            e = dict(env, YADE_BATCH=f"{table}:{ln}")
-            futs[client.submit(run_line, ln, command, e, os.getcwd(), info[ln][1], a.line_timeout, ev.name,
-                               key=f"sweep-{token}-line{ln}", pure=False)] = ln
+        futs, queue, pending = {}, list(todo), set()
         t0, last, walls = time.time(), 0.0, []
-        pending = set(futs)
+
+        def submit():
+            """Keep one line per worker thread in flight: a line is handed to a worker only when one is free, so
+            a worker that dies takes only the line it was running with it (and workers may join or leave)."""
+            nonlocal slots
+            slots = sum(client.nthreads().values())
+            while queue and len(pending) < max(slots, 1) and not stop.requested:
+                ln = queue.pop(0)
+                f = client.submit(run_line, ln, command, dict(env, YADE_BATCH=f"{table}:{ln}"), os.getcwd(), info[ln][1],
+                                  a.line_timeout, ev.name, key=f"sweep-{token}-line{ln}", pure=False)
+                futs[f] = ln
+                pending.add(f)
 
         def progress(force=False):
             nonlocal last
@@ -214,23 +220,21 @@ def main(argv=None):
             if not force and now - last < a.progress:
                 return
             last = now
-            keys = {f.key for f in pending}
-            running = min(slots, len(pending), sum(len([k for k in ks if k in keys]) for ks in client.processing().values()))
-            waiting = len(pending) - running
             mean = sum(walls) / len(walls) if walls else None
-            eta = mean * (waiting + 0.5 * running) / slots if mean else None
-            print(f"[sweep] {len(done) + len(finished)}/{len(chosen)} done, {running} running, {len(failed)} failed, "
-                  f"{waiting} waiting; elapsed {fmt_s(now - t0)}, ETA {fmt_s(eta)}", flush=True)
+            eta = mean * (len(queue) + 0.5 * len(pending)) / max(slots, 1) if mean else None
+            print(f"[sweep] {len(done) + len(finished)}/{len(chosen)} done, {len(pending)} running, {len(failed)} failed, "
+                  f"{len(queue)} waiting; elapsed {fmt_s(now - t0)}, ETA {fmt_s(eta)}", flush=True)
         try:
-            while pending:
-                if stop.requested and not ev.is_set():     # running lines stop through the Event; queued ones are cancelled
+            submit()
+            while pending or (queue and not stop.requested):
+                if stop.requested and not ev.is_set():     # the running lines stop through the Event
                     ev.set()
-                    busy = {k for ks in client.processing().values() for k in ks}
-                    client.cancel([f for f in pending if f.key not in busy])
                 try:
-                    finished_now = wait(list(pending), timeout=1.0, return_when="FIRST_COMPLETED").done
+                    finished_now = wait(list(pending), timeout=1.0, return_when="FIRST_COMPLETED").done if pending else ()
                 except TimeoutError:
                     finished_now = ()
+                if not pending:
+                    time.sleep(1.0)                         # no worker yet (a cluster still starting)
                 for f in finished_now:
                     pending.discard(f)
                     ln = futs[f]
@@ -248,21 +252,18 @@ def main(argv=None):
                             continue
                         msg = record_failure(run_dir, f"{r['reason'] or 'exit status %d' % r['rc']} on {r['host']}; last lines of the log:\n"
                                              + log_tail(run_dir))
-                    elif f.status == "cancelled":
-                        interrupted.append(ln)
-                        continue
                     else:                                   # the task itself failed: its worker died (KilledWorker), …
                         exc = f.exception()
                         msg = record_failure(run_dir, f"{type(exc).__name__}: the worker running this line died or failed ({exc}); "
                                              "last lines of the log:\n" + log_tail(run_dir))
                     failed[ln] = msg
                     print(f"[sweep] line {ln} ({desc}) FAILED: {msg.splitlines()[0]} (log: {os.path.join(run_dir, 'log.txt')})", flush=True)
+                submit()
                 progress(force=bool(finished_now))
         except KeyboardInterrupt:
             print("[sweep] quitting at once", flush=True)
-            interrupted += [futs[f] for f in pending]
         finally:
-            interrupted += [futs[f] for f in pending if futs[f] not in interrupted]
+            interrupted += [futs[f] for f in pending] + queue
             client.close()
             if cluster is not None:
                 cluster.close()
