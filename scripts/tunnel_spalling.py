@@ -55,6 +55,7 @@ def parse():
     ap.add_argument("--flaw-angle", type=float, default=cases.FLAW_ANGLE_DEG, help="flaw inclination about its toe [°] (default %(default)s)")
     ap.add_argument("--filler-mu", type=float, default=cases.FILLER_FRICTION, help="filler–rock friction μ_con of filled_flaw (default %(default)s)")
     ap.add_argument("--grout-young", type=float, default=rocks.CEMENT_GROUT["young"], help="grout E of grout_flaw [Pa] (default %(default)s)")
+    ap.add_argument("--no-pictures", dest="pictures", action="store_false", help="skip the PNG pictures (a study's many runs)")
     a = batch.parse_args(ap)                  # the command line, or a yade-batch / scripts/sweep.py table line
     a.cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     bad = [c for c in a.cases if c not in cases.TUNNEL_CASES]
@@ -126,7 +127,7 @@ class CaseRun:
             return self
         if a.resume and job.resume():
             print(f"[{self.case}] resumed at t = {s.time * 1e3:.3f} ms (step {s.steps})", flush=True)
-        else:
+        elif a.pictures:
             self.geometry_picture()
         curve = output.CurveRecorder(self.bodies["platen_displacement"], self.bodies["axial_stress"], RECORD_STEP_MM * 1e-3,
                                      state=self.state)         # the curve continues in the checkpointed record
@@ -279,7 +280,7 @@ def main():
     runs = []
     for case in a.cases:
         r = CaseRun(case, a).run()
-        r.analyse(), r.write_curve(), r.pictures()
+        r.analyse(), r.write_curve(), r.pictures() if a.pictures else None
         runs.append(r)
         with open(os.path.join(r.dir, "case.json"), "w") as f:
             json.dump(dict(r.result, first_crack=r.state["first_crack"], finished=r.state["done"]), f, indent=1)
@@ -288,7 +289,8 @@ def main():
     failed = [r.case for r in runs if r.failed]
     entries = [r.summary_entry() for r in runs]
     output.write_summary(a.out, {"cases": entries})
-    plot_curves(runs, a.out)
+    if a.pictures:
+        plot_curves(runs, a.out)
     txt = [r.text(e) for r, e in zip(runs, entries)]
     o = ordering(entries)
     if o:
