@@ -132,10 +132,11 @@ def log_tail(run_dir, n=6):
         return "".join(f.readlines()[-n:])
 
 
-def record_failure(run_dir, message):
-    """error.txt of a line the script could not record itself (killed, crashed, stopped)."""
+def record_failure(run_dir, message, replace=False):
+    """error.txt of a line the script could not record itself (killed, crashed, stopped); `replace`: also
+    when the script wrote one (a run the sweep stopped)."""
     p = os.path.join(run_dir, batch.ERROR)
-    if not os.path.exists(p):
+    if replace or not os.path.exists(p):
         os.makedirs(run_dir, exist_ok=True)
         with open(p, "w") as f:
             f.write(message + "\n")
@@ -248,7 +249,7 @@ def main(argv=None):
                             continue
                         if r["reason"] and r["reason"].startswith("stopped by the sweep"):
                             interrupted.append(ln)
-                            record_failure(run_dir, f"interrupted: {r['reason']}")
+                            record_failure(run_dir, f"interrupted: {r['reason']}", replace=True)
                             continue
                         msg = record_failure(run_dir, f"{r['reason'] or 'exit status %d' % r['rc']} on {r['host']}; last lines of the log:\n"
                                              + log_tail(run_dir))
