@@ -173,3 +173,53 @@ def test_sweep_killed_worker_loses_no_finished_line_and_a_rerun_completes_only_t
     assert sorted(merged) == sorted(d for d, _ in rows) and all(r["status"] == "ok" for r in merged.values())
     assert not (study / desc / "error.txt").exists()
     assert float(merged["long1"]["simulated_time_s"]) >= 0.008 and merged["long1"]["steps"] == merged["long2"]["steps"]
+
+
+# ------------------------------------------------------------------------------------------------ tables
+def test_table_line_becomes_the_command_line_and_bad_columns_are_named(tmp_path, monkeypatch):
+    import argparse
+    sys.path.insert(0, os.path.join(ROOT, "py"))
+    from yade_mpm import batch
+    ap = argparse.ArgumentParser(prog="demo.py")
+    ap.add_argument("--out", default="x")
+    ap.add_argument("--spacing", type=float, default=0.002)
+    ap.add_argument("--cases", default="intact")
+    ap.add_argument("--no-pictures", dest="pictures", action="store_false")
+    table = tmp_path / "t.table"
+    write_table(table, ["spacing", "cases", "pictures"], [("a", ["0.0025", "'open_flaw'", "False"]), ("b", ["=", "'intact'", "True"])])
+    monkeypatch.setenv("YADE_BATCH", f"{table}:3")
+    a = batch.parse_args(ap, [])
+    assert (a.spacing, a.cases, a.pictures, a.out) == (0.0025, "open_flaw", False, os.path.join("out", "t", "a"))
+    monkeypatch.setenv("YADE_BATCH", f"{table}:4")
+    a = batch.parse_args(ap, [])
+    assert (a.spacing, a.cases, a.pictures, a.out) == (0.0025, "intact", True, os.path.join("out", "t", "b"))
+    assert batch.lines(str(table)) == [(3, "a", os.path.join("out", "t", "a")), (4, "b", os.path.join("out", "t", "b"))]
+    write_table(table, ["spacing", "flaw_angel"], [("a", ["0.0025", "30"])])
+    monkeypatch.setenv("YADE_BATCH", f"{table}:3")
+    try:
+        batch.parse_args(ap, [])
+        raise AssertionError("an unknown column was accepted")
+    except batch.BadParameter as e:
+        assert "['flaw_angel'] are not options of demo.py; allowed: out, cases, pictures, spacing" in str(e)
+    write_table(table, ["spacing", "cases"], [("a", ["0.0025", "open_flaw"])])          # an unquoted string
+    try:
+        batch.parse_args(ap, [])
+        raise AssertionError("an unquoted string was accepted")
+    except batch.BadParameter as e:
+        assert "not a Python literal" in str(e) and "quote strings" in str(e)
+
+
+def test_shipped_tables_name_only_options_of_their_scripts():
+    import re
+    sys.path.insert(0, os.path.join(ROOT, "py"))
+    from yade_mpm import batch
+    for name in ("tunnel_spalling", "uniaxial_flaw", "penny_crack", "circular_opening"):
+        table = os.path.join(SCRIPTS, name + ".table")
+        help_text = subprocess.run([sys.executable, os.path.join(SCRIPTS, name + ".py"), "--help"], env=ENV, capture_output=True,
+                                   text=True, timeout=60).stdout
+        options = set(re.findall(r"--([a-z][a-z0-9-]*)", help_text))
+        runs = batch.lines(table)
+        assert len(runs) >= 4 and len({r for _, _, r in runs}) == len(runs), name       # one folder per line
+        for col in batch.read_table(table)[runs[0][0]]:
+            if col not in ("description", "out"):
+                assert col.replace("_", "-") in options or "no-" + col.replace("_", "-") in options, (name, col)
