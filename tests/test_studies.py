@@ -7,6 +7,8 @@
 - scripts/sweep.py on a LocalCluster with 2 workers runs a 4-line table (scripts/circular_opening.py,
   coarse); one worker is killed (SIGKILL) while it runs a line: the lines finished before stay untouched,
   the killed line is reported failed and its run process dies with its worker; a rerun runs only that line.
+- A table line reads as the same options as a command line; a misspelt column or an unquoted string is
+  refused naming it; the shipped tables name only options of their scripts.
 Every wait is bounded by a timeout.
 """
 import csv
