@@ -75,6 +75,8 @@ def run_line(line, command, env, cwd, run_dir, timeout, stop_name):
     import socket
     import subprocess
     run_dir = os.path.join(cwd, run_dir)
+    if os.path.exists(os.path.join(run_dir, "summary.csv")):   # done (Dask may recompute a task whose result it lost)
+        return dict(line=line, rc=0, wall=0.0, host=socket.gethostname(), reason=None)
     os.makedirs(run_dir, exist_ok=True)
     for f in ("error.txt", "job.json"):             # batch.ERROR, batch.JOB (no yade_mpm import needed on the worker)
         if os.path.exists(os.path.join(run_dir, f)):
@@ -238,7 +240,7 @@ def main(argv=None):
                     time.sleep(1.0)                         # no worker yet (a cluster still starting)
                 for f in finished_now:
                     pending.discard(f)
-                    ln = futs[f]
+                    ln = futs.pop(f)                        # forget it: Dask would rerun a line whose result a dead worker held
                     desc, run_dir = info[ln]
                     if f.status == "finished":
                         r = f.result()
@@ -259,6 +261,8 @@ def main(argv=None):
                                              "last lines of the log:\n" + log_tail(run_dir))
                     failed[ln] = msg
                     print(f"[sweep] line {ln} ({desc}) FAILED: {msg.splitlines()[0]} (log: {os.path.join(run_dir, 'log.txt')})", flush=True)
+                for f in finished_now:
+                    f.release()
                 submit()
                 progress(force=bool(finished_now))
         except KeyboardInterrupt:
