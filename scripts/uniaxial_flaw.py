@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import analysis, batch, cases, output, runner
+from yade_mpm import analysis, batch, cases, fidelity, output, runner
 
 DEFAULT_SPACING = 2.0e-3       # coarse default grid [m]: the whole set in < 15 min on 2 idle cores
 END_TIME = 0.014               # simulated loading time [s] (1.4 mm of platen travel); runs stop earlier once softened
@@ -111,10 +111,13 @@ def one_run(variant, mu, c_mpa, a):
     series = output.VtuSeries(d)
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
     snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})
+    fl = sc["flaw"]                                # crack sequence at the flaw ends (Fig. 11b), every 25 steps
+    times = fidelity.CrackTimes(lattice, fl["toe"], fl["tip"], analysis.softening_end(s), 2 * a.spacing) if fl else None
+    watch = [runner.Output(times.update, steps=25)] if times else []
     t0 = time.time()
     res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
                      outputs=[runner.Output(record, steps=1), runner.Output(snapshot, times=snap_times),
-                              runner.Output(series.write, period=a.vtu_every, at_end=True)])
+                              runner.Output(series.write, period=a.vtu_every, at_end=True)] + watch)
     wall = time.time() - t0
     t, eps, sig = np.array(curve).T
     output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"],
@@ -127,7 +130,9 @@ def one_run(variant, mu, c_mpa, a):
     if sc["filler"] is not None:
         p = O.bodies[sc["filler"]].state
         filler_disp = dict(dx_m=float(p.displ()[0]), dy_m=float(p.displ()[1]), rotation_rad=float(p.rot()[2]))
-    fl = sc["flaw"]                                # cracks and shear bands at the end (yade_mpm.analysis)
+    # cracks and shear bands at the end (yade_mpm.analysis); σ̃max within 2 particle rows of the flaw (Figs. 14–15)
+    near = {k: fidelity.near_segment_stress(lattice.x0, v[:, 4], fl["toe"], fl["tip"], fl["width"] / 2 + s.spacing)
+            for k, v in snaps.items()} if fl else {}
     rep = analysis.crack_report(ym.fields(s), lattice, fl and fl["polygon"], analysis.softening_end(s),
                                 flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * a.spacing)
     cracks = [{k: c[k] for k in ("length", "angle_deg", "centroid")} for c in rep["cracks"][:4] + rep["bands"][:4]]
@@ -137,12 +142,26 @@ def one_run(variant, mu, c_mpa, a):
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
                  softened=bool(res.reason == "stop"), spacing_m=a.spacing, filler_motion=filler_disp,
                  damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)),
-                 cracks_end=cracks[:len(rep["cracks"][:4])], shear_bands_end=cracks[len(rep["cracks"][:4]):])
+                 cracks_end=cracks[:len(rep["cracks"][:4])], shear_bands_end=cracks[len(rep["cracks"][:4]):],
+                 crack_times=times.result() if times else None, near_flaw_sigma_max=[dict(time_s=float(k), **v) for k, v in
+                                                                                    sorted(near.items(), key=lambda q: float(q[0])) if v],
+                 plastic_before_peak=_plastic_before(snaps, t[k]), flaw_end_cracks_end=fl and fidelity.json_safe(
+                     analysis.flaw_end_cracks(ym.get(s, "damage"), ym.get(s, "plastic_strain"), analysis.softening_end(s), lattice,
+                                              fl["toe"], fl["tip"], 2 * a.spacing)))
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
           f"{s.steps} steps, {wall:.0f} s, {entry['particle_steps_per_s'] / 1e6:.2f} M particle-steps/s", flush=True)
     return entry
+
+
+def _plastic_before(snaps, t_peak):
+    """Share of the particles with ε̄p > 1e-4 (softening under way, Eq. 34) at the last snapshot before the peak."""
+    before = [k for k in snaps if float(k) <= t_peak]
+    if not before:
+        return None
+    k = max(before, key=float)
+    return dict(time_s=float(k), share=float(np.mean(snaps[k][:, 3] > 1e-4)))
 
 
 # ------------------------------------------------------------------------------------------------ summary
@@ -286,8 +305,9 @@ def summarize(out):
             fm["rotation_change_deg"] = math.degrees(fm["rotation_rad"] - math.atan2(u[1], u[0]))
     summary = dict(case="uniaxial compression with a flaw, paper Sec. 3.3", spacing_m=runs[0]["spacing_m"],
                    sigma_max_time_s=t_sig,
-                   runs=[{k: e[k] for k in keys + ["time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end"]}
-                         for e in runs],
+                   runs=[{k: e.get(k) for k in keys + ["time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end",
+                                                       "crack_times", "near_flaw_sigma_max", "plastic_before_peak", "cracks_end", "flaw_end_cracks_end",
+                                                       "shear_bands_end"]} for e in runs],
                    total_wall_time_s=sum(e["wall_time_s"] for e in runs))
     output.write_summary(out, summary)
     print(open(os.path.join(out, "peaks.md")).read())

@@ -13,7 +13,8 @@ grown from a point (a flaw toe) reaches, how symmetric the damage is.
 
 The pieces: ``spalled``, ``shear_bands`` / ``bands``, ``cracks``, ``zone_from`` / ``clusters_touching``,
 ``mirror_symmetry``, ``opening_surface``, ``opening_distance``, ``distance_to_segment``, ``failed``,
-``softening_end``, ``region_test`` (an opening or a region of interest as shapes or a function).
+``softening_end``, ``region_test`` (an opening or a region of interest as shapes or a function),
+``flaw_end_cracks`` (wing / anti-wing cracks and shear cracks grown from the ends of a flaw).
 
 The particles of a scene built with ``add_region`` sit on a regular lattice of spacing dp = l/ppc
 in the initial configuration; the functions here work on that lattice (neighbours never change),
@@ -87,7 +88,9 @@ def bands(mask, lattice, min_sites=None):
     """Elongated clusters (8-connected lattice sites where mask is true, e.g. plastic strain past the
     softening end): a list, largest first, of dict(sites, centroid [m], length [m], angle_deg =
     inclination of the cluster's principal axis to the horizontal in (−90, 90], positive when it
-    rises to the right, elongation = ratio of the principal standard deviations). Clusters of fewer
+    rises to the right, elongation = ratio of the principal standard deviations, bbox = width, height
+    of the axis-aligned bounding box [m], fill = sites / sites of that box: 1 a rectangle, π/4 an
+    ellipse, 1/2 a right triangle with sides on the axes). Clusters of fewer
     than min_sites sites (default: max(12, 3 % of the sites in the mask)) are skipped."""
     g = lattice.grid(np.asarray(mask, bool), fill=False)
     lab, n = _label(g, 8)
@@ -107,8 +110,10 @@ def bands(mask, lattice, min_sites=None):
         ang = np.degrees(np.arctan2(major[1], major[0]))
         ang = ang - 180 if ang > 90 else (ang + 180 if ang <= -90 else ang)
         proj = (pts - c) @ major
+        box = (pts.max(axis=0) - pts.min(axis=0)) / lattice.dp + 1          # bounding box in sites
         out.append(dict(sites=int(len(pts)), centroid=c.tolist(), length=float(proj.max() - proj.min() + lattice.dp),
-                        angle_deg=float(ang), elongation=float(np.sqrt(w[1] / max(w[0], 1e-30)))))
+                        angle_deg=float(ang), elongation=float(np.sqrt(w[1] / max(w[0], 1e-30))),
+                        bbox=(box * lattice.dp).tolist(), fill=float(len(pts) / np.prod(box))))
     return sorted(out, key=lambda b: -b["sites"])
 
 
@@ -304,4 +309,37 @@ def crack_report(fields, lattice, opening, soft_end, rock=None, axis_x=None, fla
         res.update(point_damaged=int(np.count_nonzero(near & (D >= 1))), point_softened=int(np.count_nonzero(near & soft)),
                    point_failed_reach=clusters_touching(fail, lattice, near & fail) & surface,
                    point_plastic_reach=clusters_touching(plastic, lattice, near & plastic) & surface)
+    return res
+
+
+def flaw_end_cracks(damage, plastic_strain, soft_end, lattice, toe, tip, radius):
+    """Cracks grown from the two ends of a flaw (segment toe–tip [m], e.g. a flaw under vertical
+    compression), measured on the initial positions: per end ("toe", "tip") a dict with
+      damaged:   a particle with D ≥ 1 within `radius` [m] of the end (the crack has started there);
+      wing:      length [m] of the tensile crack (D ≥ 1 cluster seeded within `radius` of the end) on the
+                 side away from the flaw vertically (above the upper end, below the lower end): the
+                 largest distance of its particles from the flaw segment — the wing crack of Fig. 12;
+      anti_wing: the same on the other side (below the upper end, above the lower end);
+      shear:     the same for the softened cluster (ε̄p ≥ soft_end), either side;
+      boundary:  the D ≥ 1 or softened cluster of this end touches the lattice's outer row (the crack
+                 has run through to a face of the specimen).
+    Returns dict(toe=..., tip=..., wing, anti_wing, shear: the larger of the two ends [m])."""
+    D, e = np.asarray(damage, float), np.asarray(plastic_strain, float)
+    x0 = lattice.x0
+    a, b = np.asarray(toe, float), np.asarray(tip, float)
+    dist = distance_to_segment(x0, a, b)
+    outer = (lattice.i == 0) | (lattice.j == 0) | (lattice.i == lattice.shape[0] - 1) | (lattice.j == lattice.shape[1] - 1)
+    cracked, soft = D >= 1.0, e >= soft_end
+    res = {}
+    for name, end, other in (("toe", a, b), ("tip", b, a)):
+        near = np.hypot(*(x0 - end).T) < radius
+        up = 1.0 if end[1] >= other[1] else -1.0                 # the wing side: away from the flaw vertically
+        tens = clusters_touching(cracked, lattice, near & cracked)
+        shear = clusters_touching(soft, lattice, near & soft)
+        side = (x0[:, 1] - end[1]) * up
+        ext = lambda m: float(dist[m].max()) if m.any() else 0.0
+        res[name] = dict(damaged=bool((near & cracked).any()), wing=ext(tens & (side > 0)), anti_wing=ext(tens & (side < 0)),
+                         shear=ext(shear), boundary=bool(((tens | shear) & outer).any()))
+    for k in ("wing", "anti_wing", "shear"):
+        res[k] = max(res["toe"][k], res["tip"][k])
     return res

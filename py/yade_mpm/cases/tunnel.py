@@ -93,8 +93,17 @@ def _flaw_clear(angle, spacing):
     return bool(np.all((p >= spacing) & (p <= TUNNEL_WIDTH - spacing)) and np.all(tunnel_opening_distance(p) >= spacing))
 
 
+def tunnel_flaw_at(floor=TUNNEL_FLOOR, angle=FLAW_ANGLE, toe_gap=FLAW_TOE_GAP):
+    """``tunnel_flaw()`` for an opening with its floor at `floor` [m]: the toe `toe_gap` [m] left of the
+    left wall at spandrel height (floor + 25 mm), inclined `angle` [rad] (default FLAW_ANGLE)."""
+    angle = _number(angle, "flaw_angle", "rad")
+    toe_gap = _number(toe_gap, "flaw_toe_gap", "m", positive=True)
+    return tunnel_flaw(toe=(TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - toe_gap, floor + TUNNEL_RECT[1]), angle=angle)
+
+
 def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
-                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm"):
+                platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm",
+                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP):
     """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
     arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
     DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
@@ -105,6 +114,8 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
                           bonded to the rock through the shared grid.
     spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``);
     flaw_angle: the flaw's inclination [rad] about its toe (FLAW_ANGLE; it must leave a cell of rock to every face).
+    floor [m]: height of the opening's floor (default TUNNEL_FLOOR = 55 mm; the paper gives none, a centred
+    opening has 52.5 mm); flaw_toe_gap [m]: the toe's distance from the left wall (``tunnel_flaw_at``; not given in the paper).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
@@ -127,10 +138,10 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     from ..bodies import RigidBodies
 
     W = TUNNEL_WIDTH
-    flaw = tunnel_flaw(angle=flaw_angle) if case != "intact" else None
+    flaw = tunnel_flaw_at(floor, flaw_angle, flaw_toe_gap) if case != "intact" else None
     rock = material or rocks.pan2020_sandstone()
     holes = [flaw["polygon"]] if flaw is not None else []
-    s = arch_tunnel_specimen(spacing, rock, ppc, holes=holes)
+    s = arch_tunnel_specimen(spacing, rock, ppc, floor=floor, holes=holes)
     if case == "grout_flaw":
         add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
     O.reset()
@@ -145,17 +156,17 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
 
     def platen_displacement():
         return y0 - O.bodies[platen].state.pos[1]
-    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W,
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, floor=floor,
                    axial_stress=axial_stress, platen_displacement=platen_displacement)
 
 
-def tunnel_location(point, flaw=None):
+def tunnel_location(point, flaw=None, floor=TUNNEL_FLOOR):
     """Name of the part of the tunnel (or flaw) nearest a point [m]: "floor", "left/right corner"
     (where the walls meet the floor), "left/right wall" (the waist), "left/right spandrel" (the arch
     shoulders, more than 30° from the vertical), "crown", "flaw toe", "flaw tip", "flaw face", or
     "rock away from the opening" (more than 10 mm from the opening and the flaw)."""
     x, y = float(point[0]), float(point[1])
-    cx, floor = TUNNEL_WIDTH / 2, TUNNEL_FLOOR
+    cx = TUNNEL_WIDTH / 2
     hw, hr = TUNNEL_RECT[0] / 2, TUNNEL_RECT[1]
     if flaw is not None:
         r = np.array([x, y]) - flaw["toe"]
@@ -190,12 +201,12 @@ def tunnel_opening_distance(points, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect
     return np.minimum(d_rect, d_arch)
 
 
-def tunnel_where(points, flaw=None):
+def tunnel_where(points, flaw=None, floor=TUNNEL_FLOOR):
     """Where a set of points [m] (N, 2) lies: its most common ``tunnel_location``, or "A and B" when a
     second place holds at least a quarter as many points (damage on both sides); None for no points."""
     if len(points) == 0:
         return None
-    names = [tunnel_location(p, flaw) for p in points]
+    names = [tunnel_location(p, flaw, floor) for p in points]
     uniq, cnt = np.unique(names, return_counts=True)
     order = np.argsort(-cnt)
     return " and ".join([str(uniq[k]) for k in order if cnt[k] >= 0.25 * cnt.max()][:2])
@@ -207,7 +218,7 @@ BAND_FRACTION, BAND_MIN = 0.5, 5e-4  # band particles: ε̄p ≥ max(BAND_MIN, B
 TOE_RADIUS = 4e-3                  # the failed zone "from the flaw toe" starts within this distance of it [m]
 
 
-def tunnel_report(fields, lattice, flaw, soft_end, rock=None):
+def tunnel_report(fields, lattice, flaw, soft_end, rock=None, floor=TUNNEL_FLOOR):
     """``analysis.crack_report`` of a tunnel state (fields by id: damage, plastic_strain, mass; lattice of
     the initial positions; flaw: ``tunnel_flaw()`` or None; soft_end: ε̄p of a shear crack; rock: the
     particles that are rock, not grout), with the places named (``tunnel_location``). Returns
@@ -219,19 +230,60 @@ def tunnel_report(fields, lattice, flaw, soft_end, rock=None):
     from .. import analysis
     x0 = lattice.x0
     seg = None if flaw is None else (flaw["toe"], flaw["tip"])
-    r = analysis.crack_report(fields, lattice, arch_tunnel_holes(), soft_end, rock=rock, axis_x=TUNNEL_WIDTH / 2, flaw=seg,
+    r = analysis.crack_report(fields, lattice, arch_tunnel_holes(floor=floor), soft_end, rock=rock, axis_x=TUNNEL_WIDTH / 2, flaw=seg,
                               point=None if flaw is None else flaw["toe"], band_gap=BAND_GAP, band_fraction=BAND_FRACTION,
-                              band_floor=BAND_MIN, point_radius=TOE_RADIUS, opening_dist=tunnel_opening_distance(x0))
+                              band_floor=BAND_MIN, point_radius=TOE_RADIUS, opening_dist=tunnel_opening_distance(x0, floor=floor))
+    where = lambda pts: tunnel_where(pts, flaw, floor)
     for b in r["bands"] + r["cracks"]:
         b["side"] = "left" if b["centroid"][0] < TUNNEL_WIDTH / 2 else "right"
-        b["location"] = tunnel_location(b["centroid"], flaw)
+        b["location"] = tunnel_location(b["centroid"], flaw, floor)
     sp = r["spalled"]
     out = {k: r[k] for k in ("symmetry_damage", "symmetry_plastic", "damaged_fraction", "softened_fraction")}
     out.update(spalled_area_mm2=sp["area"] * 1e6, spalled_mass_kg_per_m=sp["mass"], spalled_particles=int(sp["mask"].sum()),
-               spalled_fragments=sp["fragments"], spalling_at=tunnel_where(x0[r["surface"]], flaw),
+               spalled_fragments=sp["fragments"], spalling_at=where(x0[r["surface"]]),
                band_threshold=r["band_threshold"], bands=r["bands"][:6], cracks=r["cracks"][:6])
+    out.update(tunnel_fidelity(fields, lattice, sp["mask"], flaw, floor, rock))
     if flaw is not None:
         out.update(toe_damaged=r["point_damaged"], toe_softened=r["point_softened"],
-                   toe_link_to_opening=tunnel_where(x0[r["point_failed_reach"]], flaw),
-                   toe_plastic_link_to_opening=tunnel_where(x0[r["point_plastic_reach"]], flaw))
+                   toe_link_to_opening=where(x0[r["point_failed_reach"]]),
+                   toe_plastic_link_to_opening=where(x0[r["point_plastic_reach"]]))
     return out, sp["mask"]
+
+
+def tunnel_fidelity(fields, lattice, spalled_mask, flaw=None, floor=TUNNEL_FLOOR, rock=None):
+    """The measures of the fidelity table (Figs. 18–19) for one tunnel state: spalled area by place
+    (``tunnel_location``) [mm²]; the waists' inward displacement (mean and 90th percentile [mm] of the
+    rock within 3 mm of each side wall, positive into the opening; needs fields["pos"]); the plastic
+    zones beside the opening (ε̄p ≥ PLASTIC_ZONE_FRACTION × its 99th percentile in the rock, the largest
+    8-connected cluster on each side: area [mm²], centroid [mm], fill of its bounding box — ½ a
+    triangle, 1 a rectangle)."""
+    from .. import analysis
+    x0, dp = lattice.x0, lattice.dp
+    rock = np.ones(len(x0), bool) if rock is None else np.asarray(rock, bool)
+    places = {}
+    for p in x0[spalled_mask]:
+        k = tunnel_location(p, flaw, floor)
+        places[k] = places.get(k, 0.0) + dp * dp * 1e6
+    out = dict(spalled_by_place_mm2={k: round(v, 1) for k, v in sorted(places.items())})
+    cx, hw = TUNNEL_WIDTH / 2, TUNNEL_RECT[0] / 2
+    band = (x0[:, 1] > floor) & (x0[:, 1] < floor + TUNNEL_RECT[1]) & rock
+    if "pos" in fields:
+        ux = (np.asarray(fields["pos"], float) - x0)[:, 0]
+        for side, sign, wall in (("left", 1.0, cx - hw), ("right", -1.0, cx + hw)):
+            m = band & (np.abs(x0[:, 0] - wall) < 3e-3) & ((x0[:, 0] - wall) * sign < 0)
+            v = sign * ux[m] * 1e3
+            out[f"{side}_waist_inward_mm"] = dict(mean=float(v.mean()), p90=float(np.percentile(v, 90))) if m.any() else None
+    e = np.asarray(fields["plastic_strain"], float)
+    ref = float(np.percentile(e[rock], 99)) if rock.any() else 0.0
+    zones = {}
+    if ref > 0:
+        for b in analysis.bands(rock & (e >= PLASTIC_ZONE_FRACTION * ref), lattice, min_sites=12):
+            side = "left" if b["centroid"][0] < cx else "right"
+            if side not in zones:
+                zones[side] = dict(area_mm2=b["sites"] * dp * dp * 1e6, centroid_mm=[c * 1e3 for c in b["centroid"]],
+                                   fill=b["fill"], bbox_mm=[c * 1e3 for c in b["bbox"]], angle_deg=b["angle_deg"])
+    out["plastic_zones"] = zones
+    return out
+
+
+PLASTIC_ZONE_FRACTION = 0.2        # a plastic zone: ε̄p ≥ this share of the rock's 99th percentile (the coloured area of Fig. 18a)
