@@ -94,8 +94,14 @@ def run_one(a, name):
     if times:
         outs.append(runner.Output(times.update, steps=25))
     t0 = time.time()
-    r = runner.run(s, end_time=a.end_time, progress=120, label=f"{a.scene}/{a.case}/{name}", advance=O.step, outputs=outs, stop=softened)
-    res.update(wall_time_s=round(time.time() - t0, 1), steps=int(s.steps), end_reason=r.reason, time_reached_s=s.time)
+    try:
+        r = runner.run(s, end_time=a.end_time, progress=120, label=f"{a.scene}/{a.case}/{name}", advance=O.step, outputs=outs, stop=softened)
+        reason = r.reason
+    except ym.MpmSimulationError as e:          # a variant the solver refuses (e.g. an inverted element): recorded, not fatal
+        reason, res["error"] = "error", str(e)
+    res.update(wall_time_s=round(time.time() - t0, 1), steps=int(s.steps), end_reason=reason, time_reached_s=s.time)
+    if len(curve) < 6:
+        return res
     c = np.array(curve)
     res["curve_shape"] = fidelity.curve_shape(c[:, 0] * 1e3, c[:, 1] / 1e6)        # mm, MPa
     res["stress_MPa_at_mm"] = {f"{m:g}": float(np.interp(m, c[:, 0] * 1e3, c[:, 1] / 1e6)) for m in (0.25, 0.5, 1.0, 1.5, 2.0)

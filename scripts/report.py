@@ -383,7 +383,8 @@ def variant_matrix(R, folder="fidelity_variants"):
                     vals.append(str(f(r) if f(r) is not None else "—"))
                 except (KeyError, TypeError, ValueError):
                     vals.append("—")
-            R.w(f"| {r['variant']}: {r['label']} | " + " | ".join(vals) + f" | {r['wall_time_s']:.0f} |")
+            stop = f" — **stopped by the solver at t = {r['time_reached_s'] * 1e3:.3f} ms**: {r['error'][:160]}" if r.get("error") else ""
+            R.w(f"| {r['variant']}: {r['label']}{stop} | " + " | ".join(vals) + f" | {r['wall_time_s']:.0f} |")
         R.w("")
     done = {r["variant"] for r in runs}
     R.w("Not run: " + (", ".join(f"{k} ({v['label']})" for k, v in fidelity.VARIANTS.items() if k not in done) or "none") + ".", "")
