@@ -97,8 +97,8 @@ def run_one(a, name):
     try:
         r = runner.run(s, end_time=a.end_time, progress=120, label=f"{a.scene}/{a.case}/{name}", advance=O.step, outputs=outs, stop=softened)
         reason = r.reason
-    except ym.MpmSimulationError as e:          # a variant the solver refuses (e.g. an inverted element): recorded, not fatal
-        reason, res["error"] = "error", str(e)
+    except (ym.MpmSimulationError, RuntimeError) as e:   # the solver refuses the state (e.g. an inverted element; through YADE a RuntimeError): recorded
+        reason, res["error"] = "error", str(e).split("ERROR:")[-1].strip().splitlines()[0]
     res.update(wall_time_s=round(time.time() - t0, 1), steps=int(s.steps), end_reason=reason, time_reached_s=s.time)
     if len(curve) < 6:
         return res
