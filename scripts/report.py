@@ -294,7 +294,8 @@ def readme_figure(R, part="tunnel", case="filled_flaw"):
     axs[0].set_xlabel("platen displacement [mm]"), axs[0].set_ylabel("axial stress [MPa]")
     axs[0].grid(alpha=0.3), axs[0].legend(fontsize=8), axs[0].set_title("axial stress (cf. paper Fig. 17)", fontsize=10)
     with np.load(snaps[-1]) as z:
-        pos, e, dmg, tms = z["pos"] * 1e3, z["epsP"], z["damage"], float(z["time"]) * 1e3
+        pos, dmg, tms = z["pos"] * 1e3, z["damage"], float(z["time"]) * 1e3
+        e = z["plastic_strain"] if "plastic_strain" in z.files else z["epsP"]      # snapshots before ym.fields: epsP
     who = os.path.basename(os.path.dirname(snaps[-1]))
     for ax, v, cmap, title, top in ((axs[1], e, "viridis", "accumulated plastic strain", np.percentile(e, 99.5)),
                                     (axs[2], dmg, "inferno", "damage D", 1.0)):

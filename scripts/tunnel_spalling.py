@@ -183,7 +183,7 @@ class CaseRun:
         return {"case": self.case, "grid_spacing_m": s.spacing, "particles": int(s.numParticles), "steps": int(st.get("steps", s.steps)),
                 "wall_time_s": round(st["wall"], 2),
                 "particle_steps_per_s": float(s.numParticles * st["steps_run"] / st["wall"]) if st["wall"] > 0 else None,
-                "final_displacement_mm": st.get("final_displacement", 0.0) * 1e3, "axial_stress_MPa_at": at,
+                "final_displacement_mm": st.get("final_displacement", c[-1, 1] if len(c) else 0.0) * 1e3, "axial_stress_MPa_at": at,
                 "symmetry_damage": snap[sym_key]["symmetry_damage"] if sym_key else None,
                 "first_damage_location": fc["location"] if fc else None}
 
