@@ -360,7 +360,7 @@ def variant_matrix(R, folder="fidelity_variants"):
         rs = sorted((r for r in runs if (r["scene"], r["case"]) == (scene, case)), key=lambda r: list(fidelity.VARIANTS).index(r["variant"]))
         r0 = rs[0]
         R.w(f"**{scene}, {case}** — grid {r0['spacing_m'] * 1e3:g} mm, loading to {r0['end_time_s'] * 1e3:g} ms (screening: "
-            f"compare with the baseline row only), build `{r0.get('build')}`", "")
+            f"compare with the baseline row only), HEAD when written `{r0.get('build')}`", "")
         if scene == "uniaxial":
             cols = [("first D = 1 at a flaw end [ms] (Fig. 11b)", lambda r: _ms(r["crack_times"]["first_tip_damage_s"])),
                     ("wing > flaw [ms] (Fig. 11b)", lambda r: _ms(r["crack_times"]["wing_longer_than_flaw_s"])),
@@ -369,22 +369,24 @@ def variant_matrix(R, folder="fidelity_variants"):
                     ("peak [MPa] at [mm] (Fig. 11a)", lambda r: f"{r['curve_shape']['peak']:.1f} at {r['curve_shape']['x_at_peak']:.3f}")]
         else:
             sn = lambda r, k: r["snapshots"].get(k) or {}
+            last = lambda r: max(r["snapshots"], key=lambda k: float(k[:-2]))       # "8ms", "12ms", ...
             cols = [("first D = 1 (Fig. 18d)", lambda r: (r["first_crack"] or {}).get("at") and f"{r['first_crack']['at']} at {r['first_crack']['time_s'] * 1e3:.1f} ms"),
                     ("σ at 0.5 / 1.0 mm [MPa] (Fig. 17)", lambda r: " / ".join(f"{r['stress_MPa_at_mm'].get(k, float('nan')):.1f}" for k in ("0.5", "1"))),
-                    ("softened % at the end (Fig. 18b, c)", lambda r: f"{100 * sn(r, max(r['snapshots']))['softened_fraction']:.2f}"),
-                    ("bands at the end (Fig. 18b)", lambda r: ", ".join(f"{b['side'][0]} {abs(b['angle_deg']):.0f}°" for b in sn(r, max(r['snapshots'])).get('bands', [])[:3])),
-                    ("plastic zones: fill L / R at 8 ms (Fig. 18a)", lambda r: " / ".join(f"{sn(r, '8ms').get('plastic_zones', {}).get(k, {}).get('fill', float('nan')):.2f}" for k in ("left", "right"))),
-                    ("toe link at the end (Fig. 19f)", lambda r: sn(r, max(r["snapshots"])).get("toe_link_to_opening")),
-                    ("left waist in [mm] p90 (Fig. 19g)", lambda r: f"{(sn(r, max(r['snapshots'])).get('left_waist_inward_mm') or {}).get('p90', float('nan')):.3f}")]
+                    ("softened % at the end (Fig. 18b, c)", lambda r: f"{100 * sn(r, last(r))['softened_fraction']:.2f}"),
+                    ("bands at the end (Fig. 18b)", lambda r: ", ".join(f"{b['side'][0]} {abs(b['angle_deg']):.0f}°" for b in sn(r, last(r)).get('bands', [])[:3])),
+                    ("plastic zones at the end: fill L / R, ½ = triangle (Fig. 18a)", lambda r: " / ".join(f"{sn(r, last(r)).get('plastic_zones', {}).get(k, {}).get('fill', float('nan')):.2f}" for k in ("left", "right"))),
+                    ("toe link at the end (Fig. 19f)", lambda r: sn(r, last(r)).get("toe_link_to_opening")),
+                    ("left waist in [mm] p90 (Fig. 19g)", lambda r: f"{(sn(r, last(r)).get('left_waist_inward_mm') or {}).get('p90', float('nan')):.3f}")]
         R.w("| variant | " + " | ".join(c for c, _ in cols) + " | wall [s] |", "|---|" + "---|" * (len(cols) + 1))
         for r in rs:
             vals = []
-            for _, f in cols:
+            for _, f in (cols if not r.get("error") else []):
                 try:
                     vals.append(str(f(r) if f(r) is not None else "—"))
                 except (KeyError, TypeError, ValueError):
                     vals.append("—")
             stop = f" — **stopped by the solver at t = {r['time_reached_s'] * 1e3:.3f} ms**: {r['error'][:160]}" if r.get("error") else ""
+            vals = vals or ["—"] * len(cols)
             R.w(f"| {r['variant']}: {r['label']}{stop} | " + " | ".join(vals) + f" | {r['wall_time_s']:.0f} |")
         R.w("")
     done = {r["variant"] for r in runs}
