@@ -30,11 +30,18 @@ inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Rea
 	for (long b = 0; b < nb; ++b) {
 		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
 			const size_t p = pp;
-			Real L[D][D] = {};
-			if (!tr.velocityGradient(p, L)) {
+			Real L[D][D] = {}, dbar[D];
+			bool cut;
+			if (!tr.velocityGradient(p, L, cut, dbar)) {
 				err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 				continue;
 			}
+			if (cut) // v_p stands at x̄_p (Transfer::g2p): move with v_p + ∇v_p (x_p − x̄_p), the velocity at x_p
+				for (int a = 0; a < D; ++a) {
+					Real c = 0;
+					for (int b = 0; b < D; ++b) c -= P.C[a * D + b][p] * dbar[b];
+					P.x[a][p] += dt * c;
+				}
 			Sym<D> de; // Δε = sym(∇v) Δt, Eq. 29
 			Sym<D> s = P.stress(p);
 			strainIncrement(L, dt, de);

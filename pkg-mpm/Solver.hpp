@@ -164,11 +164,13 @@ public:
 				if (mirrors) grid.foldMirrors(MirrorPlanes<D>::allLanes()); // symmetry planes: add the reflected images
 				stamp(t[1]);
 				if (errP2G.none()) {
-					gridUpdate(grid, dt, damping, massFloor);
+					const bool dampLate = withContact && damping > 0; // damp the net force, contact included
+					gridUpdate(grid, dt, dampLate ? 0 : damping, massFloor, dampLate);
 					stamp(t[2]);
 					if (withContact) {
 						contact.apply(cs);
 #pragma omp barrier
+						if (dampLate) dampAfterContact(grid, dt, damping, massFloor);
 					}
 					if (mirrors) grid.unfoldMirrors(); // nodes beyond a symmetry plane take their partner's reflection
 					stamp(t[3]);

@@ -142,17 +142,20 @@ public:
 				}
 				Stencil<D> st;
 				if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+				// Cut stencil: mass, momentum and external force lumped with ξ ≥ 0 (WlsShape.hpp), the particle's
+				// velocity v_p standing at the centroid x̄_p = x_p + dbar of its weights (Σ ξ (x_i − x̄_p) = 0:
+				// momentum conserved); internal force with the fitted ∇ψ (Σ_i ∇ψ_i = 0).
 				forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
-					const Real psi = st.psi[n];
-					nd.m += psi * m;      // Eq. 20
+					const Real xi = st.xi[n];
+					nd.m += xi * m;       // Eq. 20, positive lumping
 					nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
 					Real sg_g[D];
 					stressTimesVector(sg, st.grad[n], sg_g);
 					for (int a = 0; a < D; ++a) {
 						Real mom = mv[a];
-						for (int b = 0; b < D; ++b) mom += mC[a][b] * dx[b];
-						nd.a[a] += psi * mom;                  // momentum of the affine velocity field (Eq. 16)
-						nd.b[a] += -V * sg_g[a] + psi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+						for (int b = 0; b < D; ++b) mom += mC[a][b] * (dx[b] - st.dbar[b]);
+						nd.a[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
+						nd.b[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
 					}
 				});
 			});
@@ -189,9 +192,12 @@ public:
 			}
 			Stencil<D> st;
 			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+			// Cut stencil: v_p = Σ ξ_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum conserved;
+			// exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
+			// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
 			forStencil(nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
 				for (int a = 0; a < D; ++a) {
-					v[a] += st.psi[n] * nd.a[a];                                   // Eq. 6
+					v[a] += st.xi[n] * nd.a[a];                                    // Eq. 6 with positive weights
 					for (int b = 0; b < D; ++b) C[a][b] += nd.a[a] * st.grad[n][b]; // Eq. 7
 				}
 			});
@@ -200,18 +206,20 @@ public:
 				const Real wm = st.w[n] * m;
 				for (int a = 0; a < D; ++a) {
 					Real h = v[a];
-					for (int b = 0; b < D; ++b) h += C[a][b] * dx[b];
-					nd.b[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x_p)
+					for (int b = 0; b < D; ++b) h += C[a][b] * (dx[b] - st.dbar[b]);
+					nd.b[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x̄_p)
 				}
 			});
 		});
 	}
 
 	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (lanes b, Eq. 7). False if the WLS fit is singular.
-	bool velocityGradient(size_t p, Real (&L)[D][D]) const
+	// general: a cut stencil, whose v_p stands at x̄_p = x_p + dbar (g2p); dbar is left untouched otherwise.
+	bool velocityGradient(size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D]) const
 	{
 		Kernel<D> k;
 		kernelOf(p, k);
+		general = k.general;
 		if (!k.general) {
 			Real v[D];
 			gatherInterior<2 + D>(grid, k, v, L);
@@ -219,6 +227,7 @@ public:
 		}
 		Stencil<D> st;
 		if (!fillStencil(grid, offs, k, st)) return false;
+		for (int a = 0; a < D; ++a) dbar[a] = st.dbar[a];
 		forStencil(grid.nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
 			for (int a = 0; a < D; ++a)
 				for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];

@@ -19,6 +19,8 @@ struct Stencil {
 	Real   w[N];       // B-spline weight w_i(x_p), Eq. 12
 	Real   psi[N];     // ψ_i(x_p), Eq. 15
 	Real   grad[N][D]; // ∇ψ_i(x_p)
+	Real   xi[N];      // ξ_i = w_i/Σ_active w: non-negative lumping weights (= ψ_i = w_i in the interior)
+	Real   dbar[D];    // x̄_p − x_p, x̄_p = Σ ξ_i x_i the centroid of the lumping weights (0 in the interior)
 	bool   general;    // true when M was assembled from a reduced node set
 
 	// Offset of stencil node n from the base along each axis.
@@ -102,8 +104,9 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 
 	if (!general) { // interior closed form: M⁻¹ = diag(1, 3/l², …)
 		const Real s = 3.0 * invH * invH;
+		for (int a = 0; a < D; ++a) st.dbar[a] = 0; // Σ w_i (x_i − x_p) = 0 for the full B-spline stencil
 		for (int n = 0; n < N; ++n) {
-			st.psi[n] = st.w[n];
+			st.psi[n] = st.xi[n] = st.w[n];
 			for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * s * st.d[a][Stencil<D>::along(n, a)];
 		}
 		return true;
@@ -128,6 +131,19 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 			for (int a = 0; a < D; ++a) st.grad[n][a] = 0;
 		}
 		return false;
+	}
+	// Lumping weights of a cut stencil: ψ_i extrapolates beyond the active nodes (ψ up to 1 + t and −t), so a
+	// row-sum lumped mass Σ_p m_p ψ_i (Eq. 20) can be negative or vanish at a node next to excluded ones, and a
+	// node of negative mass accelerates against its force (the corner-particle blow-up next to a body). The
+	// paper's lumping is meant to be positive (text after Eq. 22, Hinton et al. 1976): mass, momentum and
+	// external forces are lumped with ξ_i = w_i/Σ_active w ≥ 0 (Σ ξ = 1: mass conserved), the same Shepard
+	// weights as the MUSL remap (Eq. 17); ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).
+	Real wsum = 0;
+	for (int n = 0; n < N; ++n) wsum += st.w[n];
+	for (int a = 0; a < D; ++a) st.dbar[a] = 0;
+	for (int n = 0; n < N; ++n) {
+		st.xi[n] = st.w[n] / wsum;
+		for (int a = 0; a < D; ++a) st.dbar[a] += st.xi[n] * st.d[a][Stencil<D>::along(n, a)];
 	}
 	MatP Minv = M.inverse();
 	for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient
