@@ -57,6 +57,7 @@
 #pragma once
 #include "BlockSchedule.hpp"
 #include "ContactGroups.hpp"
+#include "GridBoxes.hpp"
 #include "WlsShape.hpp"
 
 namespace mpm {
@@ -78,7 +79,7 @@ struct ContactNodes {
 };
 
 template <int D>
-class PtsContact : public ContactGroups<D> {
+class PtsContact : public ContactGroups<D>, private GridBoxes<D> {
 public:
 	using Vec  = typename Dim<D>::Vec;
 	using IVec = typename Dim<D>::IVec;
@@ -89,6 +90,11 @@ public:
 	using ContactGroups<D>::part;
 	using ContactGroups<D>::active;
 	using ContactGroups<D>::edgeOf;
+	using GridBoxes<D>::nodeRange;
+	using GridBoxes<D>::blockRange;
+	using GridBoxes<D>::forNodes;
+	using GridBoxes<D>::boxCount;
+	using GridBoxes<D>::boxNode;
 
 	ContactNodes<D>     nodeArr; // per-node contact arrays (sized to the grid by the first step with bodies)
 	std::vector<size_t> marked; // nodes carrying the contact exclusion bit
@@ -376,73 +382,6 @@ private:
 		if (nodeArr.size() == n) return;
 		nodeArr.resize(n);
 		marked.reserve(4096);
-	}
-	// Stored coordinates of the physical nodes within [lo, hi]; false when empty.
-	static bool nodeRange(const Grid<D>& grid, const Vec& lo, const Vec& hi, IVec& nlo, IVec& nhi)
-	{
-		const int gh = Grid<D>::ghost;
-		for (int a = 0; a < D; ++a) {
-			Real fl = (lo[a] - grid.origin[a]) / grid.spacing, fh = (hi[a] - grid.origin[a]) / grid.spacing;
-			fl      = std::max(fl, Real(0)), fh = std::min(fh, Real(grid.cells[a]));
-			if (!(fl <= fh)) return false;
-			nlo[a] = int(std::ceil(fl)) + gh, nhi[a] = int(std::floor(fh)) + gh;
-			if (nlo[a] > nhi[a]) return false;
-		}
-		return true;
-	}
-	// Block coordinates whose particles may lie within [lo, hi]; false when none holds particles.
-	static bool blockRange(const Grid<D>& grid, const BlockSchedule<D>& s, const Vec& lo, const Vec& hi, IVec& blo, IVec& bhi)
-	{
-		constexpr int B = BlockSchedule<D>::B, M = BlockSchedule<D>::margin;
-		for (int a = 0; a < D; ++a) {
-			Real fl = (lo[a] - grid.origin[a]) / grid.spacing - M, fh = (hi[a] - grid.origin[a]) / grid.spacing + M;
-			fl      = std::max(fl, Real(0)), fh = std::min(fh, Real(grid.cells[a]));
-			if (!(fl <= fh)) return false;
-			blo[a] = std::min(int(fl) / B, s.nBlocks[a] - 1), bhi[a] = std::min(int(fh) / B, s.nBlocks[a] - 1);
-		}
-		bool any = false;
-		IVec bl = blo, bh = bhi;
-		forBox(bl, bh, [&](const IVec& c) {
-			size_t b = 0, st = 1;
-			for (int a = 0; a < D; ++a) b += size_t(c[a]) * st, st *= s.nBlocks[a];
-			any = any || s.start[b] != s.start[b + 1];
-		});
-		return any;
-	}
-	template <class F>
-	static void forBox(const IVec& lo, const IVec& hi, F&& f)
-	{
-		IVec c = lo;
-		while (true) {
-			f(c);
-			int a = 0;
-			for (; a < D; ++a) {
-				if (++c[a] <= hi[a]) break;
-				c[a] = lo[a];
-			}
-			if (a == D) return;
-		}
-	}
-	template <class F>
-	static void forNodes(const Grid<D>& grid, const IVec& lo, const IVec& hi, F&& f)
-	{
-		forBox(lo, hi, [&](const IVec& c) { f(grid.linear(c)); });
-	}
-	static size_t boxCount(const IVec& lo, const IVec& hi)
-	{
-		size_t n = 1;
-		for (int a = 0; a < D; ++a) n *= size_t(hi[a] - lo[a] + 1);
-		return n;
-	}
-	static size_t boxNode(const Grid<D>& grid, const IVec& lo, const IVec& hi, size_t j)
-	{
-		size_t i = 0;
-		for (int a = 0; a < D; ++a) {
-			const size_t w = size_t(hi[a] - lo[a] + 1);
-			i += size_t(lo[a] + int(j % w)) * grid.stride[a];
-			j /= w;
-		}
-		return i;
 	}
 };
 
