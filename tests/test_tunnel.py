@@ -60,8 +60,8 @@ def test_platen_impact_stress_and_symmetry():
     dev = np.abs(np.array(sig) / rho_c_v - 1)
     assert np.mean(sig) == pytest.approx(rho_c_v, rel=0.01)
     # Since the positive lumping at cut stencils (issue 17) the platen reaction rings for ~5 µs after the
-    # first contact: up to 6.2 % at 11–16 µs (2 % before), then within 0.3 %.
-    assert np.max(dev[np.array(t) > 16e-6]) < 0.02
+    # first contact: up to 6.2 % at 11–16 µs and 2.0 % at 16 µs (before: 2 % from 11 µs on), after 20 µs within 0.3 %.
+    assert np.max(dev[np.array(t) > 20e-6]) < 0.01
     assert np.max(dev) < 0.07
     lat = analysis.Lattice(ym.get(s, "pos"), L / 2, origin=(0, 0))
     assert analysis.mirror_symmetry(ym.get(s, "stress")[:, 1], lat, W / 2) > 0.999999
