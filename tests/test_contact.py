@@ -16,8 +16,9 @@ def _rot(d, th):
     return R
 
 
-def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5):
-    """An elastic block L × H (× W) resting on a rigid box tilted by theta about z (gravity −y).
+def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5, shift=(0.0, 0.0, 0.0)):
+    """An elastic block L × H (× W) resting on a rigid box tilted by theta about z (gravity −y), the scene
+    shifted by `shift` grid cells against the grid.
     Returns (solver, part, up-slope tangent, grid spacing, block mass per metre (2D) / kg (3D))."""
     l = 0.02 if d == 2 else 0.04
     sp = l / 2
@@ -25,7 +26,7 @@ def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5):
     axes = [np.arange(sp / 2, L, sp) - (L / 2 if k != 1 else 0) for k, L in enumerate(dims)]
     loc = np.column_stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")])
     R = _rot(d, theta)
-    c0 = np.array([0.5, 0.3, 0.2][:d])
+    c0 = np.array([0.5, 0.3, 0.2][:d]) + np.asarray(shift[:d]) * l
     x = c0 + loc @ R.T
     s = ym.make_solver(np.zeros(d), (1.0, 0.8, 0.4)[:d], l)
     s.setMaterial(ym.ElasticMat(**ELASTIC))

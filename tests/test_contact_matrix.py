@@ -14,35 +14,22 @@ negative or vanishes and no corner particle blows up. Bars of the issue:
 import numpy as np
 import pytest
 import yade_mpm as ym
-from test_contact import ELASTIC, G, _com, _rot
+from test_contact import ELASTIC, G, _block_on_incline, _com, _rot
 
 SHIFTS = [(0.0, 0.0, 0.0)] + [tuple(x) for x in np.random.default_rng(1).uniform(0, 1, (7, 3))]
 
 
 def _block(d, theta, mu, shift, prestress=False):
     """Elastic block on a rigid box tilted by theta, the scene shifted by `shift` cells against the grid."""
-    l = 0.02 if d == 2 else 0.04
-    sp = l / 2
-    dims = (0.2, 0.1) if d == 2 else (0.16, 0.08, 0.08)
-    axes = [np.arange(sp / 2, L, sp) - (L / 2 if k != 1 else 0) for k, L in enumerate(dims)]
-    loc = np.column_stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")])
-    R = _rot(d, theta)
+    s, _, _, l, _ = _block_on_incline(d, theta, mu, shift=shift)
+    sp, dims, R = l / 2, ((0.2, 0.1) if d == 2 else (0.16, 0.08, 0.08)), _rot(d, theta)
     c0 = np.array([0.5, 0.3, 0.2][:d]) + np.asarray(shift[:d]) * l
-    s = ym.make_solver(np.zeros(d), (1.0, 0.8, 0.4)[:d], l)
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
-    s.addParticles(c0 + loc @ R.T, np.full(len(loc), sp ** d), np.full(len(loc), sp ** d * ELASTIC["density"]))
-    s.gravity = (0, -G, 0)[:d]
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=mu, cohesion=0.0, chi=0.5, d0=None))
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), (1.0, 0.1, 1.0)[:d])
-    s.setRigidPartState(p, c0 - 0.1 * R[:, 1], R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     if prestress:   # gravity equilibrium of a long layer of height H: σ_nn, σ_tn linear in depth
         t, n = R[:, 0], R[:, 1]
         x = np.column_stack([s.view(f"x{a}") for a in range(d)])
         depth = dims[1] - ((x - c0) @ n - sp / 2)
         snn, stn = -ELASTIC["density"] * G * depth * np.cos(theta), -ELASTIC["density"] * G * depth * np.sin(theta)
-        names = ("sig0", "sig1", "sig3") if d == 2 else ("sig0", "sig1", "sig3")
-        for name, (a, b) in zip(names, ((0, 0), (1, 1), (0, 1))):
+        for name, (a, b) in zip(("sig0", "sig1", "sig3"), ((0, 0), (1, 1), (0, 1))):
             s.view(name)[:] = (t[a] * n[b] + n[a] * t[b]) * stn + n[a] * n[b] * snn
         s.view("sig2")[:] = ELASTIC["poisson"] * snn * (1 if d == 2 else 0)
         s.requestSort()
