@@ -7,16 +7,12 @@ import pytest
 
 from yade_mpm import analysis, cases, fidelity, fidelity_table
 
-DP = 1e-3
+from test_analysis import DP
+from test_analysis import lattice as _lattice
 
 
 def lattice(nx=60, ny=80, keep=None):
-    x = (np.arange(nx) + 0.5) * DP
-    y = (np.arange(ny) + 0.5) * DP
-    X = np.stack(np.meshgrid(x, y, indexing="ij"), -1).reshape(-1, 2)
-    if keep is not None:
-        X = X[keep(X)]
-    return X, analysis.Lattice(X, DP, origin=(0, 0))
+    return _lattice(nx, ny, keep)
 
 
 # a 20 mm flaw rising to the left, toe (lower end) at (40, 30) mm, tip (upper end) at (20.0, 41.5) mm
