@@ -50,7 +50,11 @@ struct Grid {
 	IVec   cells;      // number of cells per axis
 	IVec   stored;     // stored nodes per axis (cells + 1 + 2·ghost)
 	size_t stride[3];  // linear index strides
-	std::vector<Node<D>> nodes;
+	std::vector<Node<D>>    nodes; // P2G: m, mw, momentum, force (GridNode.hpp)
+	std::vector<NodeVec<D>> vel;   // gridUpdate (+ contact): updated velocity, Eq. 18
+	std::vector<NodeVec<D>> vold;  // gridUpdate keepOld: velocity before the step, for dampAfterContact
+	std::vector<NodeVec<D>> mom;   // G2P: MUSL momentum Σ w m h_p(x_i), Eq. 16 numerator
+	std::vector<NodeVec<D>> vmusl; // gridMusl: MUSL velocity, Eqs. 16–17
 	std::vector<uint8_t> fixMask;     // bit a set: velocity component a is prescribed zero
 	std::vector<uint8_t> excluded;    // exclusion bits (ExclusionBit); any bit → left out of the WLS fits
 	std::vector<uint8_t> stencilExcl; // number of excluded nodes in the 4^D stencil starting at this node
@@ -81,6 +85,7 @@ struct Grid {
 		}
 		for (int a = D; a < 3; ++a) stride[a] = 0;
 		nodes.assign(s, Node<D> {});
+		vel.assign(s, NodeVec<D> {}), vold.assign(s, NodeVec<D> {}), mom.assign(s, NodeVec<D> {}), vmusl.assign(s, NodeVec<D> {});
 		fixMask.assign(s, 0);
 		excluded.assign(s, 0);
 		planes.clear();
@@ -229,8 +234,10 @@ struct Grid {
 	bool stencilHasExcluded(size_t base) const { return stencilExcl[base] != 0; }
 
 	// ------------------------------------------------------------------ symmetry planes (MirrorPlanes.hpp)
-	void foldMirrors(const NodeLanes& mask) { mirrors.fold(nodes, mask); }
-	void unfoldMirrors() { mirrors.unfold(nodes); }
+	template <class E>
+	void foldMirrors(std::vector<E>& field) { mirrors.fold(field); }
+	template <class E>
+	void unfoldMirrors(std::vector<E>& field) { mirrors.unfold(field); }
 	template <class F>
 	void forEachMirrorPair(F&& f) const { mirrors.forEachPair(f); }
 	Real mirrorShare(size_t i) const { return mirrors.share(coords(i)); } // weight of node i in body reactions

@@ -1,18 +1,25 @@
-// One grid node as the transfer kernels see it: a 64-byte record updated as one 8-lane vector.
+// Grid node data, one array per quantity as the step's phases produce them (paper Fig. 2):
+//
+//   nodes  Node<D>      P2G: lumped mass m (Eq. 20), Shepard mass mw = Σ w m (Eq. 17 denominator),
+//                       momentum p (Eq. 20) and force f (Eqs. 21–22)
+//   vel    NodeVec<D>   gridUpdate: updated velocity (Eq. 18), corrected by the contact (Eqs. 23–26)
+//   mom    NodeVec<D>   G2P: MUSL momentum Σ w m h_p(x_i) (Eq. 16 numerator)
+//   vmusl  NodeVec<D>   gridMusl: MUSL velocity (Eqs. 16–17), read by the stress pass (Eq. 7)
+//
+// A Node fills one 64-byte cache line (2D: 6 values + 2 padding lanes, 3D: 8), so P2G updates a whole
+// node with one 8-lane vector operation. A NodeVec holds D components (3D: + 1 padding lane), so the 4
+// nodes of a stencil row along x are one (2D) or two (3D) contiguous 8-lane vectors for the gathers
+// and the MUSL scatter (Lanes.hpp).
 #pragma once
 #include "MpmTypes.hpp"
 
 namespace mpm {
 
-// Lumped mass (Eq. 20), Shepard mass Σ w m (Eq. 17 denominator) and two vector slots reused within a
-// step: a = momentum → updated velocity, b = force → MUSL velocity.
-// A node fills one 64-byte cache line (2D: 6 values + 2 padding lanes, 3D: 8 values), so the transfer
-// kernels update a whole node with one 8-lane vector operation (lanes: m, mw, a…, b…, padding).
 template <int D>
 struct alignas(64) Node {
 	Real m, mw;
-	Real a[D];
-	Real b[D];
+	Real p[D]; // momentum
+	Real f[D]; // force
 };
 typedef Real NodeLanes __attribute__((vector_size(64), may_alias));
 static_assert(sizeof(Node<2>) == sizeof(NodeLanes) && sizeof(Node<3>) == sizeof(NodeLanes), "a node must fill one lane vector");
@@ -20,5 +27,23 @@ template <int D>
 inline NodeLanes& lanes(Node<D>& n) { return *reinterpret_cast<NodeLanes*>(&n); }
 template <int D>
 inline const NodeLanes& lanes(const Node<D>& n) { return *reinterpret_cast<const NodeLanes*>(&n); }
+
+// A nodal vector (velocity, MUSL momentum, MUSL velocity): D components, 2 lanes in 2D, 4 in 3D.
+template <int D>
+struct NodeVec {
+	static constexpr int S = D == 2 ? 2 : 4;
+	Real                 c[S];
+};
+template <int D>
+struct NodeVecLanesOf {
+	typedef Real type __attribute__((vector_size(sizeof(NodeVec<D>)), may_alias));
+};
+template <int D>
+using NodeVecLanes = typename NodeVecLanesOf<D>::type;
+template <int D>
+inline NodeVecLanes<D>& lanes(NodeVec<D>& n) { return *reinterpret_cast<NodeVecLanes<D>*>(&n); }
+template <int D>
+inline const NodeVecLanes<D>& lanes(const NodeVec<D>& n) { return *reinterpret_cast<const NodeVecLanes<D>*>(&n); }
+static_assert(sizeof(NodeVec<2>) == 16 && sizeof(NodeVec<3>) == 32, "4 NodeVecs of a row fill 1 (2D) or 2 (3D) lane vectors");
 
 } // namespace mpm

@@ -4,14 +4,13 @@
 
 namespace mpm {
 
-// Nodal momentum balance with lumped mass (Eq. 18): v_i ← p_i/m_i + Δt f_i/m_i, with Cundall local
-// damping f ← f − α|f|sign(v) and the boundary planes (fixMask). Nodes lighter than massFloor carry no
-// velocity. Lanes on entry: a = momentum, b = force; on exit: a = updated velocity, b = 0 (collects
-// the MUSL momentum next).
 // Cundall local damping of one force component f at a node moving at v (before the step).
 inline Real cundallDamped(Real f, Real v, Real alpha) { return alpha > 0 && v != 0 ? f - alpha * std::abs(f) * (v > 0 ? 1 : -1) : f; }
 
-// keepOld: lanes b keep the velocity before the step (p_i/m_i) instead of 0, for dampAfterContact.
+// Nodal momentum balance with lumped mass (Eq. 18): v_i ← p_i/m_i + Δt f_i/m_i, with Cundall local
+// damping f ← f − α|f|sign(v) and the boundary planes (fixMask). Nodes lighter than massFloor carry no
+// velocity. Reads nodes (m, momentum p, force f); writes vel; clears mom (collects the MUSL momentum
+// next). keepOld: vold ← the velocity before the step (p_i/m_i), for dampAfterContact.
 template <int D>
 inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, bool keepOld = false)
 {
@@ -19,18 +18,20 @@ inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, boo
 	const Real alpha = damping, mf = massFloor;
 #pragma omp for schedule(static)
 	for (size_t i = 0; i < nodes.size(); ++i) {
-		Node<D>&      nd  = nodes[i];
-		const uint8_t fix = grid.fixMask[i];
+		const Node<D>& nd  = nodes[i];
+		const uint8_t  fix = grid.fixMask[i];
+		NodeVec<D>     vn = {}, vo = {};
 		if (nd.m > mf) {
 			for (int a = 0; a < D; ++a) {
-				const Real v = nd.a[a] / nd.m;
-				const Real f = cundallDamped(nd.b[a], v, alpha);
-				nd.a[a]      = (fix >> a) & 1 ? 0.0 : v + dt * f / nd.m;
-				nd.b[a]      = keepOld ? v : 0.0;
+				const Real v = nd.p[a] / nd.m;
+				const Real f = cundallDamped(nd.f[a], v, alpha);
+				vn.c[a]      = (fix >> a) & 1 ? 0.0 : v + dt * f / nd.m;
+				vo.c[a]      = v;
 			}
-		} else {
-			for (int a = 0; a < D; ++a) nd.a[a] = nd.b[a] = 0;
 		}
+		grid.vel[i] = vn;
+		if (keepOld) grid.vold[i] = vo;
+		grid.mom[i] = NodeVec<D> {};
 	}
 }
 
@@ -38,26 +39,24 @@ inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, boo
 // m (v_new − v_old)/Δt, contact forces included. Damping the force before contact (gridUpdate) takes
 // α|f| off a node whose internal force the contact then balances: next to a held platen the node is at
 // rest, sign(v) flips from step to step and the reaction (−Σ contact forces) swung to 0.79–1.41 of the
-// section force at α = 0.5. Lanes on entry: a = velocity after contact, b = velocity before the step
-// (gridUpdate keepOld); on exit a = damped velocity, b = 0.
+// section force at α = 0.5. Reads vel (after contact) and vold (gridUpdate keepOld); writes vel.
 template <int D>
 inline void dampAfterContact(Grid<D>& grid, Real dt, Real damping, Real massFloor)
 {
 	auto& nodes = grid.nodes;
 #pragma omp for schedule(static)
 	for (size_t i = 0; i < nodes.size(); ++i) {
-		Node<D>&      nd  = nodes[i];
-		const uint8_t fix = grid.fixMask[i];
+		const Node<D>& nd  = nodes[i];
+		const uint8_t  fix = grid.fixMask[i];
 		if (nd.m > massFloor)
 			for (int a = 0; a < D; ++a) {
-				const Real v0 = nd.b[a], f = nd.m * (nd.a[a] - v0) / dt;
-				nd.a[a]       = (fix >> a) & 1 ? 0.0 : v0 + dt * cundallDamped(f, v0, damping) / nd.m;
+				const Real v0 = grid.vold[i].c[a], f = nd.m * (grid.vel[i].c[a] - v0) / dt;
+				grid.vel[i].c[a] = (fix >> a) & 1 ? 0.0 : v0 + dt * cundallDamped(f, v0, damping) / nd.m;
 			}
-		for (int a = 0; a < D; ++a) nd.b[a] = 0;
 	}
 }
 
-// MUSL nodal velocities (Eqs. 16–17): lanes b ← Σ w m h_p(x_i) / Σ w m, boundary planes again.
+// MUSL nodal velocities (Eqs. 16–17): vmusl ← mom / Σ w m, boundary planes again.
 template <int D>
 inline void gridMusl(Grid<D>& grid, Real massFloor)
 {
@@ -65,10 +64,11 @@ inline void gridMusl(Grid<D>& grid, Real massFloor)
 	const Real mf    = massFloor;
 #pragma omp for schedule(static)
 	for (size_t i = 0; i < nodes.size(); ++i) {
-		Node<D>&      nd  = nodes[i];
 		const uint8_t fix = grid.fixMask[i];
-		const Real    inv = nd.mw > mf ? 1.0 / nd.mw : 0.0; // Eq. 17 denominator
-		for (int a = 0; a < D; ++a) nd.b[a] = (fix >> a) & 1 ? 0.0 : nd.b[a] * inv;
+		const Real    inv = nodes[i].mw > mf ? 1.0 / nodes[i].mw : 0.0; // Eq. 17 denominator
+		NodeVec<D>    vn  = {};
+		for (int a = 0; a < D; ++a) vn.c[a] = (fix >> a) & 1 ? 0.0 : grid.mom[i].c[a] * inv;
+		grid.vmusl[i] = vn;
 	}
 }
 

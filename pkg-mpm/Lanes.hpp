@@ -10,7 +10,7 @@
 
 namespace mpm {
 
-// Lane vector of a node: m, mw, a…, b… (zero padding in 2D).
+// Lane vector of a node: m, mw, momentum…, force… (zero padding in 2D).
 template <int D>
 inline NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
 {
@@ -54,30 +54,112 @@ inline void scatterAffine(Grid<D>& g, const Kernel<D>& k, const NodeLanes& base,
 	});
 }
 
-// Interior gather of a nodal vector field u (lanes first..first+D−1): u_p = Σ w_i u_i and
-// ∇u_p = Σ u_i ⊗ ∇ψ_i with ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7).
-template <int first, int D>
-inline void gatherInterior(const Grid<D>& g, const Kernel<D>& k, Real (&u)[D], Real (&G)[D][D])
-{
-	const auto& nodes = g.nodes;
-	NodeLanes   U = {}, Gb[D] = {};
-	forRows(g, k, [&](size_t row, Real wr, const Real* dr) {
-		NodeLanes r0 = {}, r1 = {};
-		for (int i = 0; i < 4; ++i) {
-			const NodeLanes& q  = lanes(nodes[row + i]);
-			const Real       wx = k.w[0][i];
-			r0 += wx * q;
-			r1 += (wx * k.d[0][i]) * q;
+// ---- packed nodal vector fields (NodeVec: velocity, MUSL momentum, MUSL velocity) ----
+// The 4 nodes of a stencil row along x hold 4·S contiguous values (S = 2 in 2D, 4 in 3D): one or two
+// 8-lane vectors. A gather sums the rows first (weights along y[, z]) and the 4 nodes along x last (lanes);
+// a scatter adds a precomputed per-node pattern to each row: a few vector operations per row, not per node.
+typedef Real RowLanes __attribute__((vector_size(64), aligned(8), may_alias)); // unaligned 8-lane view
+template <int D>
+struct PackedRow {
+	static constexpr int S = NodeVec<D>::S, R = 4 * S / 8; // values per node, lane vectors per row
+	RowLanes             wx[R], wxd[R];                    // w_i and w_i (x_i − x_p) of node i = lane / S
+	typedef Real L4 __attribute__((vector_size(32)));
+	typedef Real L2 __attribute__((vector_size(16)));
+	explicit PackedRow(const Kernel<D>& k)
+	{
+		const L4 w = *reinterpret_cast<const L4*>(k.w[0]), wd = w * *reinterpret_cast<const L4*>(k.d[0]);
+		if constexpr (S == 2) {
+			wx[0] = __builtin_shufflevector(w, w, 0, 0, 1, 1, 2, 2, 3, 3), wxd[0] = __builtin_shufflevector(wd, wd, 0, 0, 1, 1, 2, 2, 3, 3);
+		} else {
+			wx[0] = __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1), wxd[0] = __builtin_shufflevector(wd, wd, 0, 0, 0, 0, 1, 1, 1, 1);
+			wx[1] = __builtin_shufflevector(w, w, 2, 2, 2, 2, 3, 3, 3, 3), wxd[1] = __builtin_shufflevector(wd, wd, 2, 2, 2, 2, 3, 3, 3, 3);
 		}
-		U += wr * r0;
-		Gb[0] += wr * r1;
-		for (int b = 1; b < D; ++b) Gb[b] += (wr * dr[b - 1]) * r0;
-	});
-	const Real Dinv = 3.0 / (g.spacing * g.spacing);
-	for (int a = 0; a < D; ++a) {
-		u[a] = U[first + a];
-		for (int b = 0; b < D; ++b) G[a][b] = Dinv * Gb[b][first + a];
 	}
+	// A node vector repeated in every node slot of a row (padding lanes 0).
+	static RowLanes spread(const Real* v)
+	{
+		if constexpr (S == 2) {
+			const L2 q = { v[0], v[1] };
+			return __builtin_shufflevector(q, q, 0, 1, 0, 1, 0, 1, 0, 1);
+		} else {
+			const L4 q = { v[0], v[1], v[2], 0.0 };
+			return __builtin_shufflevector(q, q, 0, 1, 2, 3, 0, 1, 2, 3);
+		}
+	}
+	// Σ over the node slots of R lane vectors: out[a] = Σ_r Σ_i x[r][i S + a].
+	static void sumNodes(const RowLanes (&x)[R], Real* out)
+	{
+		RowLanes t = x[0];
+		if constexpr (R == 2) t += x[1];
+		const L4 h = __builtin_shufflevector(t, t, 0, 1, 2, 3) + __builtin_shufflevector(t, t, 4, 5, 6, 7);
+		if constexpr (S == 2) {
+			const L2 q = __builtin_shufflevector(h, h, 0, 1) + __builtin_shufflevector(h, h, 2, 3);
+			out[0] = q[0], out[1] = q[1];
+		} else {
+			for (int a = 0; a < D; ++a) out[a] = h[a];
+		}
+	}
+};
+
+// Interior gather of a packed nodal vector field u: u_p = Σ w_i u_i and ∇u_p = Σ u_i ⊗ ∇ψ_i with
+// ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7).
+template <int D>
+inline void gatherPacked(const Grid<D>& g, const std::vector<NodeVec<D>>& field, const Kernel<D>& k, Real (&u)[D], Real (&G)[D][D])
+{
+	using PR          = PackedRow<D>;
+	constexpr int R   = PR::R;
+	const Real*   f   = field[0].c;
+	RowLanes      T[R] = {}, U[D - 1][R] = {}; // Σ_rows w_r row, Σ_rows w_r (x − x_p)_b row
+	forRows(g, k, [&](size_t row, Real wr, const Real* dr) {
+		const RowLanes* q = reinterpret_cast<const RowLanes*>(f + row * PR::S);
+		for (int r = 0; r < R; ++r) {
+			const RowLanes x = q[r];
+			T[r] += wr * x;
+			for (int b = 0; b < D - 1; ++b) U[b][r] += (wr * dr[b]) * x;
+		}
+	});
+	const PR   pr(k);
+	RowLanes   V[R], GX[R], GY[D - 1][R];
+	for (int r = 0; r < R; ++r) {
+		V[r] = pr.wx[r] * T[r], GX[r] = pr.wxd[r] * T[r];
+		for (int b = 0; b < D - 1; ++b) GY[b][r] = pr.wx[r] * U[b][r];
+	}
+	Real gb[D][D];
+	PR::sumNodes(V, u);
+	PR::sumNodes(GX, gb[0]);
+	for (int b = 0; b < D - 1; ++b) PR::sumNodes(GY[b], gb[b + 1]);
+	const Real Dinv = 3.0 / (g.spacing * g.spacing);
+	for (int a = 0; a < D; ++a)
+		for (int b = 0; b < D; ++b) G[a][b] = Dinv * gb[b][a];
+}
+
+// Interior scatter of an affine nodal vector field into a packed array: node i of the stencil receives
+// w_i (base + Σ_b slope_b (x_i − x_p)_b), slope_b = column b.
+template <int D>
+inline void scatterPacked(const Grid<D>& g, std::vector<NodeVec<D>>& field, const Kernel<D>& k, const Real (&base)[D], const Real (&slope)[D][D])
+{
+	using PR        = PackedRow<D>;
+	constexpr int R = PR::R;
+	const PR      pr(k);
+	Real          col[D];
+	RowLanes      A[R], B[D - 1][R];
+	for (int a = 0; a < D; ++a) col[a] = slope[a][0];
+	const RowLanes b0 = PR::spread(base), s0 = PR::spread(col);
+	for (int r = 0; r < R; ++r) A[r] = pr.wx[r] * b0 + pr.wxd[r] * s0;
+	for (int b = 1; b < D; ++b) {
+		for (int a = 0; a < D; ++a) col[a] = slope[a][b];
+		const RowLanes sb = PR::spread(col);
+		for (int r = 0; r < R; ++r) B[b - 1][r] = pr.wx[r] * sb;
+	}
+	Real* f = field[0].c;
+	forRows(g, k, [&](size_t row, Real wr, const Real* dr) {
+		RowLanes* q = reinterpret_cast<RowLanes*>(f + row * PR::S);
+		for (int r = 0; r < R; ++r) {
+			RowLanes x = wr * A[r];
+			for (int b = 0; b < D - 1; ++b) x += (wr * dr[b]) * B[b][r];
+			q[r] += x;
+		}
+	});
 }
 
 // Visits the 4^D nodes of a general WLS stencil: f(node, n, dx) with dx = x_i − x_p [m];

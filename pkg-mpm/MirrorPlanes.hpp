@@ -29,7 +29,6 @@ public:
 		int                 nStored;       // stored nodes along axis
 		int                 physLo, physHi; // stored index range of the physical nodes along axis
 		std::vector<size_t> columns;       // linear index of the first node (coordinate 0 along axis) of every node line along axis
-		NodeLanes           sign;          // +1, except −1 on the lanes of the normal momentum/force components
 		int                 nPairs = 0, pairK[3], pairKp[3]; // node lines within 2 cells on the material side and their partners
 	};
 
@@ -44,8 +43,6 @@ public:
 		m.axis = axis, m.side = side, m.twoP = twoP;
 		m.stride = g.stride[axis], m.nStored = g.stored[axis];
 		m.physLo = G::ghost, m.physHi = g.cells[axis] + G::ghost;
-		for (int l = 0; l < 8; ++l) m.sign[l] = 1;
-		m.sign[2 + axis] = m.sign[2 + D + axis] = -1;
 		for (size_t i = 0; i < g.size(); ++i)
 			if (g.coords(i)[axis] == 0) m.columns.push_back(i);
 		for (int k = 0; k < m.nStored; ++k) {
@@ -54,39 +51,41 @@ public:
 		}
 		list.push_back(std::move(m));
 		const Mirror& added = list.back();
-		if (groups.empty() || list[groups.back().first].axis != axis) groups.push_back({ list.size() - 1, 0, {}, {}, {} });
+		if (groups.empty() || list[groups.back().first].axis != axis) groups.push_back({ list.size() - 1, 0, {}, {} });
 		Group& g2 = groups.back();
-		for (int j = 0; j < added.nPairs; ++j) g2.k[g2.n] = added.pairK[j], g2.kp[g2.n] = added.pairKp[j], g2.sign[g2.n++] = added.sign;
+		for (int j = 0; j < added.nPairs; ++j) g2.k[g2.n] = added.pairK[j], g2.kp[g2.n] = added.pairKp[j], ++g2.n;
 	}
 
 	// Fold after a scatter: nodes within 2 cells on the material side add their partner's reflection.
-	// `mask`: 1 on the lanes to fold (all after P2G; the MUSL momentum lanes after G2P).
-	void fold(std::vector<Node<D>>& nodes, const NodeLanes& mask) const
+	// E: Node<D> (after P2G, all lanes) or NodeVec<D> (the MUSL momentum after G2P).
+	template <class E>
+	void fold(std::vector<E>& nodes) const
 	{
 		for (const auto& g : groups) {
-			const Mirror& m = list[g.first];
-			NodeLanes     ms[6];
-			for (int e = 0; e < g.n; ++e) ms[e] = mask * g.sign[e];
-			const long nc = long(m.columns.size());
+			const Mirror& m  = list[g.first];
+			const auto    sg = signLanes(nodes.data(), m.axis);
+			const long    nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				Node<D>* col = &nodes[m.columns[size_t(c)]];
-				for (int e = 0; e < g.n; ++e) lanes(col[size_t(g.k[e]) * m.stride]) += ms[e] * lanes(col[size_t(g.kp[e]) * m.stride]);
+				E* col = &nodes[m.columns[size_t(c)]];
+				for (int e = 0; e < g.n; ++e) lanes(col[size_t(g.k[e]) * m.stride]) += sg * lanes(col[size_t(g.kp[e]) * m.stride]);
 			}
 		}
 	}
 	// Unfold: every node beyond a plane takes the reflection of its partner (planes in reverse order).
-	void unfold(std::vector<Node<D>>& nodes) const
+	template <class E>
+	void unfold(std::vector<E>& nodes) const
 	{
 		for (auto it = groups.rbegin(); it != groups.rend(); ++it) {
 			const Group&  g  = *it;
 			const Mirror& m  = list[g.first];
+			const auto    sg = signLanes(nodes.data(), m.axis);
 			const long    nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				Node<D>* col = &nodes[m.columns[size_t(c)]];
+				E* col = &nodes[m.columns[size_t(c)]];
 				for (int e = g.n - 1; e >= 0; --e)
-					if (g.k[e] != g.kp[e]) lanes(col[size_t(g.kp[e]) * m.stride]) = g.sign[e] * lanes(col[size_t(g.k[e]) * m.stride]);
+					if (g.k[e] != g.kp[e]) lanes(col[size_t(g.kp[e]) * m.stride]) = sg * lanes(col[size_t(g.k[e]) * m.stride]);
 			}
 		}
 	}
@@ -153,19 +152,6 @@ public:
 		for (int j = 0; j < n; ++j) f(list8[j]);
 	}
 
-	static NodeLanes allLanes()
-	{
-		NodeLanes l;
-		for (int i = 0; i < 8; ++i) l[i] = 1;
-		return l;
-	}
-	static NodeLanes secondVectorLanes() // lanes b (MUSL momentum)
-	{
-		NodeLanes l = {};
-		for (int a = 0; a < D; ++a) l[2 + D + a] = 1;
-		return l;
-	}
-
 private:
 	std::vector<Mirror> list;
 	// Consecutive planes along the same axis (the two sides of a block, ≥ 2 cells apart) touch disjoint
@@ -175,9 +161,25 @@ private:
 		size_t    first; // its first plane in list (columns, stride)
 		int       n;     // (k, kp) pairs of all its planes, in plane order
 		int       k[6], kp[6];
-		NodeLanes sign[6];
 	};
 	std::vector<Group> groups;
+
+	// +1 on every lane except −1 on the normal component of the vectors (mass is even, the normal
+	// momentum, force and velocity odd).
+	static NodeLanes signLanes(const Node<D>*, int axis)
+	{
+		NodeLanes l;
+		for (int i = 0; i < 8; ++i) l[i] = 1;
+		l[2 + axis] = l[2 + D + axis] = -1;
+		return l;
+	}
+	static NodeVecLanes<D> signLanes(const NodeVec<D>*, int axis)
+	{
+		NodeVecLanes<D> l;
+		for (int i = 0; i < NodeVec<D>::S; ++i) l[i] = 1;
+		l[axis] = -1;
+		return l;
+	}
 
 	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
 	// including the line on the plane (k == kp).

@@ -242,7 +242,7 @@ public:
 				const Vec     f   = c.fn + ft;
 				const uint8_t fix = grid.fixMask[i];
 				for (int a = 0; a < D; ++a) {
-					grid.nodes[i].a[a] = (fix >> a) & 1 ? 0.0 : c.v[a] + dt * f[a] / c.m;
+					grid.vel[i].c[a] = (fix >> a) & 1 ? 0.0 : c.v[a] + dt * f[a] / c.m;
 					A.force[a][i]      = f[a];
 				}
 			};
@@ -320,7 +320,7 @@ private:
 		const Vec xi = grid.position(i);
 		c.part       = g.parts.size() == 1 ? g.parts[0] : g.query(xi).part;
 		const auto& q = parts[c.part];
-		for (int a = 0; a < D; ++a) c.v[a] = nd.a[a];
+		for (int a = 0; a < D; ++a) c.v[a] = grid.vel[i].c[a];
 		c.n  = c.fn / fnorm, c.r = xi - q.c;
 		c.vt = tangential(c.v + (dt / nd.m) * c.fn - q.velocityAt(xi), c.n); // Eqs. 26, 25
 		c.m    = nd.m;

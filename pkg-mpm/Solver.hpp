@@ -161,7 +161,7 @@ public:
 #pragma omp parallel
 			{
 				xfer.p2g(mat, g, s, viewWrites, errP2G);
-				if (mirrors) grid.foldMirrors(MirrorPlanes<D>::allLanes()); // symmetry planes: add the reflected images
+				if (mirrors) grid.foldMirrors(grid.nodes); // symmetry planes: add the reflected images
 				stamp(t[1]);
 				if (errP2G.none()) {
 					const bool dampLate = withContact && damping > 0; // damp the net force, contact included
@@ -172,14 +172,14 @@ public:
 #pragma omp barrier
 						if (dampLate) dampAfterContact(grid, dt, damping, massFloor);
 					}
-					if (mirrors) grid.unfoldMirrors(); // nodes beyond a symmetry plane take their partner's reflection
+					if (mirrors) grid.unfoldMirrors(grid.nodes), grid.unfoldMirrors(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
 					stamp(t[3]);
 					if (errContact.none()) {
 						xfer.g2p(errG2P);
 						if (errG2P.none()) {
-							if (mirrors) grid.foldMirrors(MirrorPlanes<D>::secondVectorLanes());
+							if (mirrors) grid.foldMirrors(grid.mom);
 							gridMusl(grid, massFloor);
-							if (mirrors) grid.unfoldMirrors();
+							if (mirrors) grid.unfoldMirrors(grid.vmusl);
 						}
 					}
 				}

@@ -154,8 +154,8 @@ public:
 					for (int a = 0; a < D; ++a) {
 						Real mom = mv[a];
 						for (int b = 0; b < D; ++b) mom += mC[a][b] * (dx[b] - st.dbar[b]);
-						nd.a[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
-						nd.b[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+						nd.p[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
+						nd.f[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
 					}
 				});
 			});
@@ -163,31 +163,24 @@ public:
 	}
 
 	// ------------------------------------------------------------ G2P + MUSL remap: Eqs. 6–7, 16–17
-	// Particle velocity and its WLS gradient from the updated nodal velocities (lanes a), then the
-	// particle's local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m (lanes b).
+	// Particle velocity and its WLS gradient from the updated nodal velocities (vel), then the particle's
+	// local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m (into mom).
 	void g2p(ErrorRecord& err)
 	{
-		auto& nodes = grid.nodes;
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
 			kernelOf(p, k);
 			const Real m = P.mass[p];
 			Real       v[D] = {}, C[D][D] = {};
 			if (!k.general) {
-				gatherInterior<2>(grid, k, v, C); // Eqs. 6–7 from the updated velocities (lanes a)
+				gatherPacked(grid, grid.vel, k, v, C); // Eqs. 6–7 from the updated velocities
 				storeVelocity(p, v, C);
-				NodeLanes H[D + 1]; // m h_p(x_i) = m (v + ∇v (x_i − x_p)) into lanes b
-				{
-					const Real zero[D] = {};
-					Real       mvv[D], mc[D];
-					for (int a = 0; a < D; ++a) mvv[a] = m * v[a];
-					H[D] = nodeLanes<D>(0, 0, zero, mvv);
-					for (int b = 0; b < D; ++b) {
-						for (int a = 0; a < D; ++a) mc[a] = m * C[a][b];
-						H[b] = nodeLanes<D>(0, 0, zero, mc);
-					}
+				Real mvv[D], mc[D][D]; // m h_p(x_i) = m (v + ∇v (x_i − x_p))
+				for (int a = 0; a < D; ++a) {
+					mvv[a] = m * v[a];
+					for (int b = 0; b < D; ++b) mc[a][b] = m * C[a][b];
 				}
-				scatterAffine(grid, k, H[D], H); // Eq. 16 numerator, Σ w m h_p(x_i)
+				scatterPacked(grid, grid.mom, k, mvv, mc); // Eq. 16 numerator, Σ w m h_p(x_i)
 				return;
 			}
 			Stencil<D> st;
@@ -195,25 +188,25 @@ public:
 			// Cut stencil: v_p = Σ ξ_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum conserved;
 			// exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 			// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
-			forStencil(nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
+			forStencil(grid.vel.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
 				for (int a = 0; a < D; ++a) {
-					v[a] += st.xi[n] * nd.a[a];                                    // Eq. 6 with positive weights
-					for (int b = 0; b < D; ++b) C[a][b] += nd.a[a] * st.grad[n][b]; // Eq. 7
+					v[a] += st.xi[n] * nd.c[a];                                    // Eq. 6 with positive weights
+					for (int b = 0; b < D; ++b) C[a][b] += nd.c[a] * st.grad[n][b]; // Eq. 7
 				}
 			});
 			storeVelocity(p, v, C);
-			forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
+			forStencil(grid.mom.data(), offs, st, [&](NodeVec<D>& nd, int n, const Real(&dx)[D]) {
 				const Real wm = st.w[n] * m;
 				for (int a = 0; a < D; ++a) {
 					Real h = v[a];
 					for (int b = 0; b < D; ++b) h += C[a][b] * (dx[b] - st.dbar[b]);
-					nd.b[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x̄_p)
+					nd.c[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x̄_p)
 				}
 			});
 		});
 	}
 
-	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (lanes b, Eq. 7). False if the WLS fit is singular.
+	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (vmusl, Eq. 7). False if the WLS fit is singular.
 	// general: a cut stencil, whose v_p stands at x̄_p = x_p + dbar (g2p); dbar is left untouched otherwise.
 	bool velocityGradient(size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D]) const
 	{
@@ -222,15 +215,15 @@ public:
 		general = k.general;
 		if (!k.general) {
 			Real v[D];
-			gatherInterior<2 + D>(grid, k, v, L);
+			gatherPacked(grid, grid.vmusl, k, v, L);
 			return true;
 		}
 		Stencil<D> st;
 		if (!fillStencil(grid, offs, k, st)) return false;
 		for (int a = 0; a < D; ++a) dbar[a] = st.dbar[a];
-		forStencil(grid.nodes.data(), offs, st, [&](const Node<D>& nd, int n, const Real(&)[D]) {
+		forStencil(grid.vmusl.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
 			for (int a = 0; a < D; ++a)
-				for (int c = 0; c < D; ++c) L[a][c] += nd.b[a] * st.grad[n][c];
+				for (int c = 0; c < D; ++c) L[a][c] += nd.c[a] * st.grad[n][c];
 		});
 		return true;
 	}

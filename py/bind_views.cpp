@@ -108,7 +108,7 @@ struct ViewsWrap {
 		for (size_t i = 0; i < n; ++i) {
 			reinterpret_cast<double*>(m.get_data())[i]  = s.grid.nodes[i].m;
 			reinterpret_cast<double*>(mw.get_data())[i] = s.grid.nodes[i].mw;
-			for (int a = 0; a < D; ++a) reinterpret_cast<double*>(v.get_data())[i * D + a] = s.grid.nodes[i].b[a];
+			for (int a = 0; a < D; ++a) reinterpret_cast<double*>(v.get_data())[i * D + a] = s.grid.vmusl[i].c[a];
 		}
 		return bp::make_tuple(m, mw, v);
 	}
