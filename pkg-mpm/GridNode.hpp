@@ -30,7 +30,7 @@ inline const NodeLanes& lanes(const Node<D>& n) { return *reinterpret_cast<const
 
 // A nodal vector (velocity, MUSL momentum, MUSL velocity): D components, 2 lanes in 2D, 4 in 3D.
 template <int D>
-struct NodeVec {
+struct alignas(D == 2 ? 16 : 32) NodeVec { // aligned as its lane vector (C++17 aligned new in std::vector)
 	static constexpr int S = D == 2 ? 2 : 4;
 	Real                 c[S];
 };
