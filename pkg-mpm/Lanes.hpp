@@ -7,6 +7,7 @@
 // WLS ψ_i, ∇ψ_i of fillStencil.
 #pragma once
 #include "WlsShape.hpp"
+#include <immintrin.h>
 
 namespace mpm {
 
@@ -78,6 +79,10 @@ struct PackedRow {
 	// A node vector repeated in every node slot of a row (padding lanes 0).
 	static RowLanes spread(const Real* v)
 	{
+#ifdef __AVX512F__ // one broadcast from registers (a vector built on the stack stalls on store forwarding)
+		if constexpr (S == 2) return RowLanes(_mm512_broadcast_f64x2(_mm_set_pd(v[1], v[0])));
+		else return RowLanes(_mm512_broadcast_f64x4(_mm256_set_pd(0.0, v[2], v[1], v[0])));
+#endif
 		if constexpr (S == 2) {
 			const L2 q = { v[0], v[1] };
 			return __builtin_shufflevector(q, q, 0, 1, 0, 1, 0, 1, 0, 1);
