@@ -65,6 +65,7 @@ def parse_args(argv=None):
                         "that are ≤ a and divide L/2)")
     p.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all cores)")
     p.add_argument("--progress", type=float, default=10.0, help="wall seconds between progress lines")
+    ym.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
     p.add_argument("--no-vtu", dest="vtu", action="store_false", help="skip the VTU particle file")
     p.add_argument("--vtu-every", type=float, default=0.0,
                    help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "
@@ -88,6 +89,7 @@ def check_args(a):
     if a.boundary_load == "consistent":
         ym.consistent_row_weights(a.ppc)              # raises for ppc = 1
     ym.check_setting("damping", a.damping, "--damping")  # the solver's declared range
+    a.courant = ym.check_courant(a.courant)
     if not (math.isfinite(a.tol) and a.tol > 0):
         raise ValueError(f"--tol = {a.tol} must be > 0")
     if a.max_time is not None and not (math.isfinite(a.max_time) and a.max_time > 0):
@@ -229,6 +231,7 @@ def evaluate(s, samples, spacing, ppc, domain):
 def run_case(spacing, args, label, series=None):
     t0 = time.time()
     s, _, _ = cases.circular_opening(spacing, args.domain, args.ppc, args.damping, args.boundary_load)
+    s.courant = args.courant
     samples = LineSamples(s, spacing, args.ppc)
     converged, hist = relax(s, samples, args, spacing, label, series)
     wall = time.time() - t0
@@ -335,7 +338,7 @@ def main(argv=None):
         write_convergence(args.out, table)
     summary = dict(case="circular opening (paper Sec. 3.1) vs Kirsch (Eqs. 41-42)", domain_m=args.domain,
                    hole_radius_m=RADIUS, far_field_MPa=dict(sxx=SXX_FAR / MPa, syy=SYY_FAR / MPa),
-                   ppc=args.ppc, damping=args.damping, boundary_load=args.boundary_load, tol=args.tol, threads=ym.getThreads(),
+                   ppc=args.ppc, damping=args.damping, courant=args.courant, boundary_load=args.boundary_load, tol=args.tol, threads=ym.getThreads(),
                    kirsch_hoop_theta0_MPa=3 * SYY_FAR / MPa - SXX_FAR / MPa,
                    kirsch_hoop_theta90_MPa=3 * SXX_FAR / MPa - SYY_FAR / MPa)
     summary.update(main_res)

@@ -42,6 +42,7 @@ from yade_mpm import batch, cases, rocks, runner
 ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
 HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
 PAPER_RAMP = 0.5                       # s
+COURANT = ym.setting_default("courant")   # --courant sets it (default: the solver's C)
 SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
 
 
@@ -51,6 +52,7 @@ def build(size, h, material, P, ramp, damping, crack_nodes="shared", edges="free
     none); "slip" zeroes the normal velocity, "fixed" every component; "topbottom" acts on the faces
     y = 0, L only, "all" also on x = 0, L."""
     s, geo = cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK)
+    s.courant = COURANT
     if edges != "free":
         for axis in ((1,) if edge_set == "topbottom" else (0, 1)):
             s.addBoundaryPlane(axis, -1, 0.0, edges)
@@ -291,6 +293,7 @@ def main(argv=None):
     ap.add_argument("--vtu", action="store_true", help="also write VTU particle files of the damage snapshots")
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
     ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
+    ym.courant_option(ap)
     a = batch.parse_args(ap, argv)    # the command line, or a yade-batch / scripts/sweep.py table line
     parts = set(a.parts.split(","))
     if not parts <= {"elastic", "convergence", "damage"}:
@@ -304,6 +307,11 @@ def main(argv=None):
         ap.error(f"--half-length must lie in (0, size/4) = (0, {a.size / 4:g}) m")
     global HALF_CRACK
     HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
+    global COURANT
+    try:
+        COURANT = ym.check_courant(a.courant)
+    except ValueError as e:
+        ap.error(str(e))
     if a.full:
         a.spacing = 0.02
     if a.threads > 0:
@@ -315,7 +323,7 @@ def main(argv=None):
                                threshold_volume=rocks.granite_dpgk(**damage_options(a, "benz-asphaug")).thresholdVolume,
                                damage_strain=a.damage_strain,
                                threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
-                               edges=a.edges, edge_set=a.edge_set, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
+                               edges=a.edges, edge_set=a.edge_set, courant=COURANT, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
                                threads=ym.getThreads()))
     wall0 = time.time()
     particles = 0

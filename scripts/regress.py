@@ -18,6 +18,7 @@ results stay within these tolerances of the numbers a reference build stored:
     /usr/bin/python3 scripts/regress.py --out /tmp/reg --record FILE      # store this build's numbers
     ... --tree DIR      run another checkout's scripts and package (e.g. a worktree of the reference build)
     ... --only kirsch,sneddon   a subset (tunnel and uniaxial take minutes)
+    ... --courant C     every case at the Courant number C (a Δt study; the reference is at the solver's default)
 
 Each case runs in its own subprocess with one thread (results do not depend on the thread count);
 --jobs of them at a time. Exit code 0 when every checked number is within its tolerance, 1 otherwise.
@@ -35,6 +36,7 @@ REFERENCE = os.path.join(ROOT, "scripts", "regress_reference.json")
 UNIAXIAL_RUNS = ("intact", "open", "filled_mu0.4_c0MPa")
 TUNNEL_SIZE_MM = 150.0
 REUSE = False   # --reuse: read the outputs already in OUT instead of running
+COURANT = None  # --courant: every case at this C (default: each script's default, the solver's C)
 
 # case: (script, arguments); {out} is the case's output folder
 CASES = {
@@ -65,7 +67,9 @@ def run_case(tree, name, out):
         return read_numbers(name, d), 0.0
     env = dict(os.environ, PYTHONPATH=os.path.join(tree, "py"), OMP_NUM_THREADS="1")
     t0 = time.time()
-    r = subprocess.run([sys.executable, os.path.join(tree, "scripts", script), "--out", d, *argv], env=env, capture_output=True, text=True)
+    extra = ["--courant", f"{COURANT:g}"] if COURANT is not None else []
+    r = subprocess.run([sys.executable, os.path.join(tree, "scripts", script), "--out", d, *argv, *extra], env=env, capture_output=True,
+                       text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{name}: {script} failed (exit {r.returncode}):\n{r.stdout[-1500:]}\n{r.stderr[-3000:]}")
     return read_numbers(name, d), time.time() - t0
@@ -117,10 +121,11 @@ def main():
     ap.add_argument("--only", default=",".join(CASES), help=f"comma-separated subset of {', '.join(CASES)}")
     ap.add_argument("--jobs", type=int, default=2, help="cases run at a time (default 2)")
     ap.add_argument("--reuse", action="store_true", help="read the outputs already in OUT (a finished earlier run) instead of running")
+    ap.add_argument("--courant", type=float, default=None, help="run every case at this Courant number (a study of Δt; default: the solver's)")
     ap.add_argument("--note", default="", help="--record: text stored with the numbers (e.g. the commit)")
     a = ap.parse_args()
-    global REUSE
-    REUSE = a.reuse
+    global REUSE, COURANT
+    REUSE, COURANT = a.reuse, a.courant
     names = [n.strip() for n in a.only.split(",") if n.strip()]
     if not names or any(n not in CASES for n in names):
         ap.error(f"--only: allowed {', '.join(CASES)}")

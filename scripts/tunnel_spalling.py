@@ -44,8 +44,7 @@ def parse():
     ap.add_argument("--spacing", type=float, default=None, help=f"grid spacing l [m] (default {DEFAULT_SPACING})")
     ap.add_argument("--paper", action="store_true", help=f"the paper's grid, l = {PAPER_SPACING} m (83 k particles)")
     ap.add_argument("--end-time", type=float, default=cases.TUNNEL_END_TIME, help="loading time [s] (default 0.02)")
-    ap.add_argument("--courant", type=float, default=0.5,
-                    help="Courant number C of Δt = C·l/(v_c + max|v|) (default 0.5; C = 1, the paper's Δt, inverts the platen corner)")
+    ym.courant_option(ap)                     # default: the solver's C (pkg-mpm/SolverSettings.hpp)
     ap.add_argument("--threads", type=int, default=None, help="OpenMP threads (default: all cores)")
     ap.add_argument("--vtu-every", type=float, default=4e-3, help="simulated seconds between VTU files, plus 8, 12, 20 ms (default 0.004)")
     ap.add_argument("--checkpoint-every", default="5min",
@@ -68,8 +67,10 @@ def parse():
         ap.error(f"--spacing = {a.spacing} m must be in (0, {cases.TUNNEL_MAX_SPACING}] (the 2 mm flaw must cut a full particle row)")
     if not (0 < a.end_time <= 0.1):
         ap.error(f"--end-time = {a.end_time} s must be in (0, 0.1]")
-    if not (0 < a.courant <= 1):
-        ap.error(f"--courant = {a.courant} must be in (0, 1]")
+    try:
+        a.courant = ym.check_courant(a.courant)
+    except ValueError as e:
+        ap.error(str(e))
     if a.threads is not None and a.threads < 1:
         ap.error("--threads must be ≥ 1")
     if not a.vtu_every > 0:

@@ -71,6 +71,7 @@ def parse(argv=None):
     p.add_argument("--runs", default=None, help="subset, e.g. intact,open,filled:0.4:0 (variant:mu_con:c_con_MPa)")
     p.add_argument("--vtu-every", type=float, default=1e-3, help="VTU period [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=30.0, help="wall seconds between progress lines")
+    ym.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
     p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json (and a study's OUT/*/runs/*/run.json) "
                    "into the summary")
     p.add_argument("--filler-blocked-dofs", default="zXY", help="blockedDOFs of the filler (default %(default)s: free in the "
@@ -82,6 +83,10 @@ def parse(argv=None):
     if not (a.spacing > 0 and a.end_time > 0 and a.vtu_every > 0):
         p.error("--spacing, --end-time and --vtu-every must be > 0")
     a.run_list = parse_runs(a.runs) if a.runs else all_runs()
+    try:
+        a.courant = ym.check_courant(a.courant)
+    except ValueError as e:
+        p.error(str(e))
     return a
 
 
@@ -93,6 +98,7 @@ def one_run(variant, mu, c_mpa, a):
     os.makedirs(d, exist_ok=True)
     s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
                                 filler_blocked=a.filler_blocked_dofs)
+    s.courant = a.courant
     curve, snaps = [], {}
 
     def record(solver):
@@ -140,7 +146,7 @@ def one_run(variant, mu, c_mpa, a):
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
-                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, filler_motion=filler_disp,
+                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, courant=a.courant, filler_motion=filler_disp,
                  damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)),
                  cracks_end=cracks[:len(rep["cracks"][:4])], shear_bands_end=cracks[len(rep["cracks"][:4]):],
                  crack_times=times.result() if times else None, near_flaw_sigma_max=[dict(time_s=float(k), **v) for k, v in

@@ -32,6 +32,28 @@ def check_setting(name, value, option=None):
     return value
 
 
+def setting_default(name):
+    """The declared default of a solver setting (pkg-mpm/SolverSettings.hpp), e.g. for a script option
+    whose default is the solver's: read here, never repeated."""
+    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+    if name not in probe.settings():
+        raise ValueError(f"unknown solver setting '{name}'; known: {', '.join(probe.settings())}")
+    return getattr(probe, name)
+
+
+def courant_option(ap):
+    """Adds --courant to a script's argparse parser: default None = the solver's declared C (read, not
+    repeated); a value is checked against the declared range by :func:`check_courant`."""
+    ap.add_argument("--courant", type=float, default=None,
+                    help=f"Courant number C of the step Δt = C·l/(v_c + max|v|) (default: the solver's, {setting_default('courant'):g})")
+
+
+def check_courant(value, option="--courant"):
+    """`value` checked against the solver's declared range (None: the solver's default); returns the C
+    a run will use."""
+    return setting_default("courant") if value is None else check_setting("courant", value, option)
+
+
 GAP_NODES = ("excluded", "shared")
 
 
