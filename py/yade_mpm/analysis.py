@@ -282,7 +282,9 @@ def crack_report(fields, lattice, opening, soft_end, rock=None, axis_x=None, fla
     band_gap), cracks (``cracks``), symmetry_damage, symmetry_plastic, damaged_fraction,
     softened_fraction (of the rock); with point: point_damaged, point_softened (counts within
     point_radius), point_failed_reach, point_plastic_reach (per particle: the zone grown from the point
-    on the opening surface)."""
+    on the opening surface), point_failed_gap (distance [m] from the opening of the failed zone grown from
+    the point: 0 when it reaches it; None: no failed particle near the point) and point_failed_gap_at (the
+    particle where that distance is smallest)."""
     D, e = np.asarray(fields["damage"], float), np.asarray(fields["plastic_strain"], float)
     n = len(lattice.i)
     if D.shape != (n,) or e.shape != (n,):
@@ -306,8 +308,11 @@ def crack_report(fields, lattice, opening, soft_end, rock=None, axis_x=None, fla
         near = rock & (np.hypot(*(lattice.x0 - np.asarray(point, float)).T) < point_radius)
         surface = opening_surface(lattice, in_opening)
         plastic = rock & (e >= thr)
+        zone_fail = clusters_touching(fail, lattice, near & fail)
+        gap_at = int(np.argmin(np.where(zone_fail, dist, np.inf))) if zone_fail.any() else None
         res.update(point_damaged=int(np.count_nonzero(near & (D >= 1))), point_softened=int(np.count_nonzero(near & soft)),
-                   point_failed_reach=clusters_touching(fail, lattice, near & fail) & surface,
+                   point_failed_reach=zone_fail & surface, point_failed_gap=None if gap_at is None else float(dist[gap_at]),
+                   point_failed_gap_at=gap_at,
                    point_plastic_reach=clusters_touching(plastic, lattice, near & plastic) & surface)
     return res
 

@@ -226,7 +226,8 @@ def tunnel_report(fields, lattice, flaw, soft_end, rock=None, floor=TUNNEL_FLOOR
     softened_fraction, spalled_area_mm2, spalled_mass_kg_per_m, spalled_particles, spalled_fragments,
     spalling_at, band_threshold, bands (each with side and location), cracks, and with a flaw toe_damaged,
     toe_softened, toe_link_to_opening, toe_plastic_link_to_opening (where the zone from the toe
-    reaches the opening)."""
+    reaches the opening), toe_failed_gap_mm and toe_failed_nearest (how far from the opening the failed
+    zone from the toe ends [mm], 0 = it reaches it, and the place of the opening nearest to it)."""
     from .. import analysis
     x0 = lattice.x0
     seg = None if flaw is None else (flaw["toe"], flaw["tip"])
@@ -246,6 +247,8 @@ def tunnel_report(fields, lattice, flaw, soft_end, rock=None, floor=TUNNEL_FLOOR
     if flaw is not None:
         out.update(toe_damaged=r["point_damaged"], toe_softened=r["point_softened"],
                    toe_link_to_opening=where(x0[r["point_failed_reach"]]),
+                   toe_failed_gap_mm=None if r["point_failed_gap"] is None else r["point_failed_gap"] * 1e3,
+                   toe_failed_nearest=None if r["point_failed_gap_at"] is None else tunnel_location(x0[r["point_failed_gap_at"]], None, floor),
                    toe_plastic_link_to_opening=where(x0[r["point_plastic_reach"]]))
     return out, sp["mask"]
 
