@@ -142,6 +142,8 @@ def t_toe_corner(t):
     o = _snap(t, "open_flaw", "20ms") or {}
     txt = (f"failed zone (D = 1 or softened) from the filled flaw's toe reaches the opening at: {s.get('toe_link_to_opening') or 'nowhere'} "
            f"(open flaw: {o.get('toe_link_to_opening') or 'nowhere'}); plastic band from the toe: {s.get('toe_plastic_link_to_opening') or 'nowhere'}")
+    if s.get("toe_failed_gap_mm") is not None:
+        txt += f"; the failed zone grown from the toe ends {s['toe_failed_gap_mm']:.1f} mm from the opening, nearest its {s['toe_failed_nearest']}"
     return txt, "agrees" if _hit(s.get("toe_link_to_opening")) else ("partly: a plastic band, not a crack" if _hit(s.get("toe_plastic_link_to_opening")) else "differs")
 
 
