@@ -230,7 +230,7 @@ def _quantities(rows):
               for m in (0.5, 1.0, 1.5, 2.0)]
         q += [(f"tunnel {case}: first D = 1 [ms], place", lambda r, k=k: r[k]["first_crack"] and (r[k]["first_crack"]["time_ms"], r[k]["first_crack"]["place"]),
                None, "time rel ≤ 0.02, same place" if case == "intact" else None),
-              (f"tunnel {case}: platen penetration at 8 / 20 ms, row mean / max [µm]", lambda r, k=k: _pen(r[k]["penetration"]), None, None),
+              (f"tunnel {case}: platen penetration at 4 / 8 / 20 ms, row mean [µm]", lambda r, k=k: _pen(r[k]["penetration"]), None, None),
               (f"tunnel {case}: steps to the end, finished", lambda r, k=k: (r[k]["steps"], r[k]["finished"], r[k]["end_mm"]), None, None)]
     for run in ("open", "filled_mu0.6_c0MPa", "intact", "filled_mu0.4_c0MPa"):
         k = f"uniaxial_{run}"
@@ -249,7 +249,7 @@ def _quantities(rows):
 
 def _pen(series):
     at = {round(p["time_s"] * 1e3): p for p in series}
-    return tuple(at[t][k] * 1e6 if t in at else None for t in (8, 20) for k in ("mean_m", "max_m"))
+    return tuple(at[t]["mean_m"] * 1e6 if t in at else None for t in (4, 8, 20))
 
 
 def _show(v, fmt):
@@ -262,30 +262,29 @@ def _show(v, fmt):
     return (fmt or "{}").format(v)
 
 
-def markdown(rows):
-    """The table quantity × C, with the relative change of each C against the smallest C run (the
-    converged reference) where a number is compared."""
+def markdown(rows, base=None):
+    """The table quantity × C, with the relative change of each C against `base` (default: the solver's
+    C, the default the study is about) where a number is compared."""
+    from .scene import setting_default
+    base = setting_default("courant") if base is None else base
     Cs = sorted(rows, reverse=True)
-    ref = Cs[-1]
-    head = "| quantity | " + " | ".join(f"C = {C:g}" for C in Cs) + " | " + " | ".join(f"C = {C:g} vs {ref:g}" for C in Cs[:-1]) + " | regress tolerance |"
-    out = [head, "|---|" + "---|" * (2 * len(Cs))]
+    others = [C for C in Cs if C != base]
+    head = "| quantity | " + " | ".join(f"C = {C:g}" for C in Cs) + " | " + " | ".join(f"C = {C:g} vs {base:g}" for C in others) + " | regress tolerance |"
+    out = [head, "|---|" + "---|" * (len(Cs) + len(others) + 1)]
     for label, get, fmt, tol in _quantities(rows):
-        vals = []
+        vals = {}
         for C in Cs:
             try:
-                vals.append(get(rows[C]))
+                vals[C] = get(rows[C])
             except (KeyError, TypeError):
-                vals.append(None)
-        if all(v is None for v in vals):
+                vals[C] = None
+        if all(v is None for v in vals.values()):
             continue
         ch = []
-        for v in vals[:-1]:
-            r = vals[-1]
-            if isinstance(v, tuple) and isinstance(r, tuple) and v and r and isinstance(v[0], float) and isinstance(r[0], float) and r[0]:
-                ch.append(f"{(v[0] - r[0]) / abs(r[0]):+.2%}")
-            elif isinstance(v, float) and isinstance(r, float) and r:
-                ch.append(f"{(v - r) / abs(r):+.2%}")
-            else:
-                ch.append("—")
-        out.append(f"| {label} | " + " | ".join(_show(v, fmt) for v in vals) + " | " + " | ".join(ch) + f" | {tol or '—'} |")
+        first = lambda v: v[0] if isinstance(v, tuple) and v else v
+        r = first(vals.get(base))
+        for C in others:
+            v = first(vals[C])
+            ch.append(f"{(v - r) / abs(r):+.2%}" if isinstance(v, float) and isinstance(r, float) and r else "—")
+        out.append(f"| {label} | " + " | ".join(_show(vals[C], fmt) for C in Cs) + " | " + " | ".join(ch) + f" | {tol or '—'} |")
     return "\n".join(out)
