@@ -27,13 +27,13 @@ import numpy as np
 
 import yade_mpm as ym
 from yade_mpm import analysis, batch, cases, output, resumable, rocks, runner
+from yade_mpm.cases import tunnel_results as results
 
 SNAPSHOTS_MS = (8.0, 12.0, 20.0)          # field pictures (Figs. 18a–c, 19)
 CURVE_STEP_MM = 0.1                       # summary.json: axial stress every 0.1 mm
 RECORD_STEP_MM = 0.01                     # CSV: mean platen stress over every 0.01 mm of displacement
 DEFAULT_SPACING = 2e-3                    # default grid [m] (README main command: four cases < 20 min)
 PAPER_SPACING = 1e-3                      # paper Sec. 4
-OLD_KEYS = {"epsP": "plastic_strain", "smax": "max_principal_stress"}   # snapshot names before ym.fields
 
 
 def parse():
@@ -107,16 +107,12 @@ class CaseRun:
 
     def watch_damage(self, solver):
         """The first tensile crack (D = 1): when, where, how many particles."""
-        if self.state["first_crack"] is None and solver.view("damage").max() >= 1.0:
-            pts = self.x0[solver.view("id")[solver.view("damage") >= 1.0]]
-            self.state["first_crack"] = dict(time=solver.time, displacement=self.bodies["platen_displacement"](), particles=len(pts),
-                                             centroid=pts.mean(axis=0).tolist(), location=cases.tunnel_where(pts, self.flaw))
+        if self.state["first_crack"] is None:
+            self.state["first_crack"] = results.first_crack(solver, self.x0, self.bodies["platen_displacement"](), self.flaw)
 
     def snapshot(self, solver):
         """Fields for the pictures and the analysis at 8, 12, 20 ms (id order), kept in an .npz."""
-        f = ym.fields(solver, ["pos", "damage", "plastic_strain", "max_principal_stress", "mass"])
-        name = f"snapshot_{int(round(solver.time * 1e3)):02d}ms.npz"      # 08ms, 12ms, 20ms (or where a run stopped)
-        np.savez_compressed(os.path.join(self.dir, name), displacement=self.bodies["platen_displacement"](), **f)
+        name = results.save_snapshot(solver, self.dir, self.bodies["platen_displacement"]())
         if name not in self.state["snapshots"]:
             self.state["snapshots"].append(name)
 
@@ -166,27 +162,12 @@ class CaseRun:
 
     def analyse(self):
         """yade_mpm.analysis on every snapshot (cases.tunnel_report: the places named)."""
-        soft_end = analysis.softening_end(self.solver)
-        self.snaps, self.result = {}, {"snapshots": {}}
-        for name in self.state["snapshots"]:
-            with np.load(os.path.join(self.dir, name)) as z:
-                f = self.snaps[name[9:13]] = {OLD_KEYS.get(k, k): z[k] for k in z.files}
-            rep, f["spalled"] = cases.tunnel_report(f, self.lattice, self.flaw, soft_end, rock=self.rock)
-            self.result["snapshots"][name[9:13]] = dict(time_ms=float(f["time"] * 1e3), displacement_mm=float(f["displacement"] * 1e3), **rep)
+        self.snaps, self.result = results.analyse_snapshots(self.dir, self.state["snapshots"], self.lattice, self.flaw,
+                                                            analysis.softening_end(self.solver), rock=self.rock)
         return self.result
 
     def summary_entry(self):
-        st, s, snap = self.state, self.solver, self.result["snapshots"]
-        c = np.array(st["curve"]) if st["curve"] else np.zeros((0, 3))
-        at = [{"displacement_mm": d, "stress_MPa": v / 1e6} for d, v in output.sample_curve(c[:, 1] * 1e3, c[:, 2], CURVE_STEP_MM)]
-        sym_key = "08ms" if "08ms" in snap else (sorted(snap)[-1] if snap else None)
-        fc = st["first_crack"]
-        return {"case": self.case, "grid_spacing_m": s.spacing, "particles": int(s.numParticles), "steps": int(st.get("steps", s.steps)),
-                "wall_time_s": round(st["wall"], 2),
-                "particle_steps_per_s": float(s.numParticles * st["steps_run"] / st["wall"]) if st["wall"] > 0 else None,
-                "final_displacement_mm": st.get("final_displacement", c[-1, 1] if len(c) else 0.0) * 1e3, "axial_stress_MPa_at": at,
-                "symmetry_damage": snap[sym_key]["symmetry_damage"] if sym_key else None,
-                "first_damage_location": fc["location"] if fc else None}
+        return results.summary_entry(self.case, self.solver, self.state, self.result, CURVE_STEP_MM)
 
     def write_curve(self):
         rows = [(t, d * 1e3, sig / 1e6) for t, d, sig in self.state["curve"]]
@@ -263,16 +244,6 @@ def plot_curves(runs, out):
     output.save_figure(fig, os.path.join(out, "axial_stress.png"), dpi=130)
 
 
-def ordering(entries):
-    """At equal displacement: open_flaw < intact < filled_flaw (paper Fig. 17)? Share of the 0.1 mm samples."""
-    by = {e["case"]: {p["displacement_mm"]: p["stress_MPa"] for p in e["axial_stress_MPa_at"]} for e in entries}
-    if not all(k in by for k in ("intact", "open_flaw", "filled_flaw")):
-        return None
-    ds = sorted(set(by["intact"]) & set(by["open_flaw"]) & set(by["filled_flaw"]) - {0.0})
-    ok = [by["open_flaw"][d] < by["intact"][d] < by["filled_flaw"][d] for d in ds]
-    return dict(samples=len(ds), holds=int(sum(ok)), fraction=(sum(ok) / len(ds)) if ds else None)
-
-
 def main():
     a = parse()
     if a.threads:
@@ -293,36 +264,17 @@ def main():
     if a.pictures:
         plot_curves(runs, a.out)
     txt = [r.text(e) for r, e in zip(runs, entries)]
-    o = ordering(entries)
+    o = results.ordering(entries)
     if o:
         txt.append(f"Fig. 17 ordering open_flaw < intact < filled_flaw holds at {o['holds']} of {o['samples']} displacements (0.1 mm apart)")
     open(os.path.join(a.out, "summary.txt"), "w").write("\n\n".join(txt) + "\n")
     if not failed and all(r.state["done"] for r in runs) and len(runs) == len(a.cases):
-        batch.write_summary(a.out, [study_row(r, e, a) for r, e in zip(runs, entries)])   # a study's rows: one per case
+        batch.write_summary(a.out, [results.study_row(r.case, r.state, r.result, e, vars(a)) for r, e in zip(runs, entries)])   # a study's rows: one per case
     print("\n\n".join(txt))
     print(f"results in {os.path.abspath(a.out)}")
     if failed:
         print(f"stopped by the solver in: {', '.join(failed)} (outputs written up to the stop)", file=sys.stderr)
         sys.exit(1)
-
-
-def study_row(r, e, a):
-    """The case's row of OUT/summary.csv (a study's line, scripts/study_report.py): parameters and results, no wall time."""
-    at = {p["displacement_mm"]: p["stress_MPa"] for p in e["axial_stress_MPa_at"]}
-    c = np.array(r.state["curve"])
-    k = int(np.argmax(c[:, 2]))
-    last = r.result["snapshots"][max(r.result["snapshots"])] if r.result["snapshots"] else {}
-    fc = r.state["first_crack"]
-    return dict(case=r.case, spacing_m=a.spacing, end_time_s=a.end_time, courant=a.courant,
-                flaw_angle_deg=a.flaw_angle if r.case != "intact" else None,
-                filler_mu=a.filler_mu if r.case == "filled_flaw" else None,
-                grout_young_GPa=a.grout_young / 1e9 if r.case == "grout_flaw" else None,
-                particles=e["particles"], steps=e["steps"], final_displacement_mm=e["final_displacement_mm"],
-                **{f"stress_MPa_at_{d:g}mm": at.get(d) for d in (0.5, 1.0, 1.5, 2.0)},
-                peak_stress_MPa=float(c[k, 2] / 1e6), displacement_at_peak_mm=float(c[k, 1] * 1e3),
-                first_damage_mm=fc["displacement"] * 1e3 if fc else None, first_damage_at=fc["location"] if fc else None,
-                spalled_area_mm2=last.get("spalled_area_mm2"), damaged_fraction=last.get("damaged_fraction"),
-                softened_fraction=last.get("softened_fraction"), spalling_at=last.get("spalling_at"))
 
 
 if __name__ == "__main__":

@@ -19,9 +19,7 @@ sigma_max_open_vs_filled.png.
 Each invocation also writes OUT/summary.csv, one row per run (doc/studies.md).
 """
 import argparse
-import glob
 import json
-import math
 import os
 import sys
 import time
@@ -30,6 +28,8 @@ import numpy as np
 
 import yade_mpm as ym
 from yade_mpm import analysis, batch, cases, fidelity, output, runner
+from yade_mpm.cases import uniaxial_results as results
+from yade_mpm.cases.uniaxial_results import find_run as _find, read_curve as _curve, read_snapshot as _snap
 
 DEFAULT_SPACING = 2.0e-3       # coarse default grid [m]: the whole set in < 15 min on 2 idle cores
 END_TIME = 0.014               # simulated loading time [s] (1.4 mm of platen travel); runs stop earlier once softened
@@ -44,10 +44,6 @@ def all_runs():
     runs += [("filled", mu, 0.0) for mu in MU_SWEEP]
     runs += [("filled", 0.0, c) for c in C_SWEEP_MPA if c != 0.0]
     return runs
-
-
-def run_name(variant, mu, c):
-    return variant if variant != "filled" else f"filled_mu{mu:g}_c{c:g}MPa"
 
 
 def parse_runs(text):
@@ -93,7 +89,7 @@ def parse(argv=None):
 # ------------------------------------------------------------------------------------------------ one run
 def one_run(variant, mu, c_mpa, a):
     from yade import O
-    name = run_name(variant, mu, c_mpa)
+    name = results.run_name(variant, mu, c_mpa)
     d = os.path.join(a.out, "runs", name)
     os.makedirs(d, exist_ok=True)
     s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
@@ -108,12 +104,8 @@ def one_run(variant, mu, c_mpa, a):
         f = ym.fields(solver, ["pos", "damage", "plastic_strain", "max_principal_stress"])
         snaps[f"{solver.time:.6e}"] = np.column_stack([f["pos"], f["damage"], f["plastic_strain"], f["max_principal_stress"]])
 
-    def softened(solver):       # stop after the peak: stress below 60 % of a peak of ≥ 5 MPa, 20 % later than it
-        if solver.steps % 50:
-            return False
-        st = [q[2] for q in curve]
-        k = int(np.argmax(st))
-        return st[k] > 5e6 and st[-1] < 0.6 * st[k] and solver.time > 1.2 * curve[k][0]
+    def softened(solver):       # stop after the peak (checked every 50 steps)
+        return solver.steps % 50 == 0 and results.softened(curve, solver.time)
     series = output.VtuSeries(d)
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
     snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})
@@ -129,31 +121,18 @@ def one_run(variant, mu, c_mpa, a):
     output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"],
                      np.column_stack([t, eps, sig / 1e6]))
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
-    k = int(np.argmax(sig))
-    pre = (sig > 0.1 * sig[k]) & (sig < 0.4 * sig[k]) & (np.arange(len(sig)) < k)
-    E = np.polyfit(eps[pre], sig[pre], 1)[0] if pre.sum() > 3 else float("nan")
-    filler_disp = None
-    if sc["filler"] is not None:
-        p = O.bodies[sc["filler"]].state
-        filler_disp = dict(dx_m=float(p.displ()[0]), dy_m=float(p.displ()[1]), rotation_rad=float(p.rot()[2]))
+    k, E = results.peak_and_modulus(eps, sig)
     # cracks and shear bands at the end (yade_mpm.analysis); σ̃max within 2 particle rows of the flaw (Figs. 14–15)
-    near = {k: fidelity.near_segment_stress(lattice.x0, v[:, 4], fl["toe"], fl["tip"], fl["width"] / 2 + s.spacing)
-            for k, v in snaps.items()} if fl else {}
-    rep = analysis.crack_report(ym.fields(s), lattice, fl and fl["polygon"], analysis.softening_end(s),
-                                flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * a.spacing)
-    cracks = [{k: c[k] for k in ("length", "angle_deg", "centroid")} for c in rep["cracks"][:4] + rep["bands"][:4]]
+    end = results.end_analytics(s, lattice, fl, snaps, a.spacing)
     entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
-                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, courant=a.courant, filler_motion=filler_disp,
-                 damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)),
-                 cracks_end=cracks[:len(rep["cracks"][:4])], shear_bands_end=cracks[len(rep["cracks"][:4]):],
-                 crack_times=times.result() if times else None, near_flaw_sigma_max=[dict(time_s=float(k), **v) for k, v in
-                                                                                    sorted(near.items(), key=lambda q: float(q[0])) if v],
-                 plastic_before_peak=_plastic_before(snaps, t[k]), flaw_end_cracks_end=fl and fidelity.json_safe(
-                     analysis.flaw_end_cracks(ym.get(s, "damage"), ym.get(s, "plastic_strain"), analysis.softening_end(s), lattice,
-                                              fl["toe"], fl["tip"], 2 * a.spacing)))
+                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, courant=a.courant,
+                 filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
+                 **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
+                 crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
+                 plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"])
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
@@ -161,38 +140,7 @@ def one_run(variant, mu, c_mpa, a):
     return entry
 
 
-def _plastic_before(snaps, t_peak):
-    """Share of the particles with ε̄p > 1e-4 (softening under way, Eq. 34) at the last snapshot before the peak."""
-    before = [k for k in snaps if float(k) <= t_peak]
-    if not before:
-        return None
-    k = max(before, key=float)
-    return dict(time_s=float(k), share=float(np.mean(snaps[k][:, 3] > 1e-4)))
-
-
 # ------------------------------------------------------------------------------------------------ summary
-def load_runs(out):
-    runs = []
-    for f in sorted(glob.glob(os.path.join(out, "runs", "*", "run.json")) + glob.glob(os.path.join(out, "*", "runs", "*", "run.json"))):
-        with open(f) as fh:
-            e = json.load(fh)
-        e["dir"] = os.path.dirname(f)
-        runs.append(e)
-    return runs
-
-
-def _curve(e):
-    c = np.loadtxt(os.path.join(e["dir"], "curve.csv"), delimiter=",", skiprows=1, ndmin=2)
-    return c[:, 1], c[:, 2]
-
-
-def _find(runs, variant, mu=0.0, c=0.0):
-    for e in runs:
-        if e["variant"] == variant and abs(e["mu_con"] - mu) < 1e-9 and abs(e["c_con_MPa"] - c) < 1e-9:
-            return e
-    return None
-
-
 def sweep_png(runs, out, key, values, fname, title):
     plt = output.pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5))
@@ -218,19 +166,8 @@ def sweep_png(runs, out, key, values, fname, title):
     plt.close(fig)
 
 
-def _snap(e, t):
-    z = np.load(os.path.join(e["dir"], "snapshots.npz"))
-    keys = sorted(z.files, key=float)
-    k = min(keys, key=lambda q: abs(float(q) - t))
-    return float(k), z[k]
-
-
-def _has_snaps(e):
-    return bool(np.load(os.path.join(e["dir"], "snapshots.npz")).files)
-
-
 def damage_png(e, out):
-    if not _has_snaps(e):
+    if not results.has_snapshots(e):
         return
     plt = output.pyplot()
     fig, axs = plt.subplots(2, len(SNAP_TIMES), figsize=(2.2 * len(SNAP_TIMES), 9.5), sharey=True)
@@ -254,7 +191,7 @@ def damage_png(e, out):
 
 def sigma_png(runs, out):
     op, fi = _find(runs, "open"), _find(runs, "filled", mu=0.4) or _find(runs, "filled")
-    if op is None or fi is None or not (_has_snaps(op) and _has_snaps(fi)):
+    if op is None or fi is None or not (results.has_snapshots(op) and results.has_snapshots(fi)):
         return None
     plt = output.pyplot()
     t = op["time_at_peak_s"]
@@ -277,7 +214,7 @@ def sigma_png(runs, out):
 
 
 def summarize(out):
-    runs = load_runs(out)
+    runs = results.load_runs(out)
     if not runs:
         print(f"no runs under {out}/runs")
         return None
@@ -286,42 +223,20 @@ def summarize(out):
     for e in runs:
         damage_png(e, out)
     t_sig = sigma_png(runs, out)
-    keys = ["variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "youngs_modulus_GPa", "wall_time_s",
-            "particles", "steps", "particle_steps_per_s"]
-    order = {"intact": 0, "open": 1, "filled": 2}
-    runs.sort(key=lambda e: (order[e["variant"]], e["c_con_MPa"], e["mu_con"]))
-    rows = [[e[k] for k in keys] for e in runs]
-    output.write_csv(os.path.join(out, "peaks.csv"), keys, rows)
+    keys = results.SUMMARY_KEYS
+    results.sort_runs(runs)
+    output.write_csv(os.path.join(out, "peaks.csv"), keys, [[e[k] for k in keys] for e in runs])
     long = []
     for e in runs:                                 # every curve in one file (every 10th recorded step)
         eps, sig = _curve(e)
         long += [[os.path.basename(e["dir"]), a, b] for a, b in zip(eps[::10], sig[::10])]
     output.write_csv(os.path.join(out, "curves.csv"), ["run", "axial_strain", "axial_stress_MPa"], long)
     with open(os.path.join(out, "peaks.md"), "w") as f:
-        f.write("| variant | μ_con | c_con [MPa] | peak [MPa] | ε at peak | E [GPa] | wall [s] | particles | steps | M p-steps/s |\n")
-        f.write("|---|---|---|---|---|---|---|---|---|---|\n")
-        for e in runs:
-            f.write(f"| {e['variant']} | {e['mu_con']:g} | {e['c_con_MPa']:g} | {e['peak_stress_MPa']:.2f} | {e['strain_at_peak']:.4f} | "
-                    f"{e['youngs_modulus_GPa']:.2f} | {e['wall_time_s']:.0f} | {e['particles']} | {e['steps']} | "
-                    f"{e['particle_steps_per_s'] / 1e6:.2f} |\n")
-    u = cases.uniaxial_flaw_geometry()["direction"]
-    for e in runs:   # YADE's rot() is measured from refOri = identity: subtract the filler's initial angle
-        fm = e.get("filler_motion")
-        if fm:
-            fm["rotation_change_deg"] = math.degrees(fm["rotation_rad"] - math.atan2(u[1], u[0]))
-    summary = dict(case="uniaxial compression with a flaw, paper Sec. 3.3", spacing_m=runs[0]["spacing_m"],
-                   sigma_max_time_s=t_sig,
-                   runs=[{k: e.get(k) for k in keys + ["time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end",
-                                                       "crack_times", "near_flaw_sigma_max", "plastic_before_peak", "cracks_end", "flaw_end_cracks_end",
-                                                       "shear_bands_end"]} for e in runs],
-                   total_wall_time_s=sum(e["wall_time_s"] for e in runs))
+        f.write(results.peaks_markdown(runs))
+    summary = results.summary(runs, t_sig)
     output.write_summary(out, summary)
     print(open(os.path.join(out, "peaks.md")).read())
     return summary
-
-
-ROW_KEYS = ("variant", "mu_con", "c_con_MPa", "spacing_m", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s",
-            "youngs_modulus_GPa", "particles", "steps", "end_reason", "softened", "damaged_fraction_end")
 
 
 def main(argv=None):
@@ -332,7 +247,7 @@ def main(argv=None):
         print(f"all runs: {time.time() - t0:.0f} s wall")
     summarize(a.out)
     if not a.summary_only:                         # a study's rows (scripts/study_report.py): no wall times
-        batch.write_summary(a.out, [dict({k: e[k] for k in ROW_KEYS}, end_time_s=a.end_time) for e in entries])
+        batch.write_summary(a.out, [dict({k: e[k] for k in results.ROW_KEYS}, end_time_s=a.end_time) for e in entries])
 
 
 if __name__ == "__main__":

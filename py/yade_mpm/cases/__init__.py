@@ -10,10 +10,15 @@ scenes here and keep only their command line, plots and narrative.
     uniaxial_flaw(variant, spacing, ...)  paper Sec. 3.3: 50 × 150 mm specimen, platen, open/rigid-filled flaw
     yade_platen / yade_filler / yade_engines   the rigid YADE bodies and engines of those loading scenes
     tunnel_location / tunnel_where / tunnel_report   names of places around the tunnel, its crack analytics
+    tunnel_results    a tunnel run's records: first crack, snapshots and their analysis, summary entry,
+                      study row, Fig. 17 ordering (scripts/tunnel_spalling.py)
+    uniaxial_results  a uniaxial flaw run's records: post-peak stop, peak and modulus, end-of-run crack
+                      analytics, the runs' summary (scripts/uniaxial_flaw.py)
 
 Rock parameters come from ``yade_mpm.rocks``; the small scenes of the stability suite live with their
 checks in ``yade_mpm.validation.stability``. Modules: elastic (Secs. 3.1, 3.2, boundary checks),
-tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies). Quantities are SI; stresses are tension positive inside the solver.
+tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies), tunnel_results, uniaxial_results
+(imported by name: ``from yade_mpm.cases import tunnel_results``). Quantities are SI; stresses are tension positive inside the solver.
 """
 from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING_SXX, OPENING_SYY, apply_far_field,
                       circular_opening, fixed_free_bar, line_crack, mode_period, uniform_stress_block)

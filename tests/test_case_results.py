@@ -1,0 +1,48 @@
+"""The run records of yade_mpm.cases.tunnel_results / uniaxial_results on constructed curves whose
+answers are known (the scripts' end-to-end tests run them on real runs: test_tunnel_script, test_studies)."""
+import numpy as np
+import pytest
+
+from yade_mpm.cases import tunnel_results, uniaxial_results
+
+
+def entry(case, stresses):
+    return {"case": case, "axial_stress_MPa_at": [{"displacement_mm": 0.1 * k, "stress_MPa": s} for k, s in enumerate(stresses)]}
+
+
+def test_fig17_ordering_counts_the_samples_where_it_holds():
+    e = [entry("intact", [0, 10, 20, 30]), entry("open_flaw", [0, 9, 21, 29]), entry("filled_flaw", [0, 11, 22, 29.5])]
+    o = tunnel_results.ordering(e)
+    assert o == dict(samples=3, holds=1, fraction=pytest.approx(1 / 3))   # 0.1 mm holds; 0.2 (open above), 0.3 (filled below) do not
+    assert tunnel_results.ordering(e[:2]) is None
+
+
+def test_sampled_curve_every_step_in_mm_and_MPa():
+    curve = [[0.0, 0.0, 0.0], [1.0, 0.2e-3, 4e6], [2.0, 0.45e-3, 9e6]]            # time, displacement [m], stress [Pa]
+    s = tunnel_results.sample_curve(curve, 0.1)
+    assert [p["displacement_mm"] for p in s] == pytest.approx([0.0, 0.1, 0.2, 0.3, 0.4])
+    assert [p["stress_MPa"] for p in s] == pytest.approx([0.0, 2.0, 4.0, 6.0, 8.0])
+
+
+def test_peak_and_modulus_of_a_linear_then_softening_curve():
+    eps = np.linspace(0, 2e-3, 201)
+    E = 9.87e9
+    sig = np.where(eps <= 1e-3, E * eps, E * 1e-3 - 5e9 * (eps - 1e-3))
+    k, e_fit = uniaxial_results.peak_and_modulus(eps, sig)
+    assert eps[k] == pytest.approx(1e-3) and e_fit == pytest.approx(E, rel=1e-9)
+    assert np.isnan(uniaxial_results.peak_and_modulus(eps[:3], sig[:3])[1])     # too few points before the peak
+
+
+def test_softened_only_past_a_real_peak():
+    rise = [(t, 0.0, 1e6 * t) for t in range(11)]                              # peak 10 MPa at t = 10
+    assert not uniaxial_results.softened(rise, 10.0)
+    drop = rise + [(13.0, 0.0, 5.9e6)]
+    assert uniaxial_results.softened(drop, 13.0)                                # < 60 % of the peak, t > 1.2 × 10
+    assert not uniaxial_results.softened(drop, 11.5)                            # too soon after the peak
+    small = [(t, 0.0, 1e5 * t) for t in range(11)] + [(13.0, 0.0, 1e5)]
+    assert not uniaxial_results.softened(small, 13.0)                           # a peak below 5 MPa is no peak
+
+
+def test_run_names():
+    assert uniaxial_results.run_name("open", 0.4, 1.0) == "open"
+    assert uniaxial_results.run_name("filled", 0.4, 0.0) == "filled_mu0.4_c0MPa"
