@@ -6,13 +6,14 @@
 //     contact.beforeTransfer(step)   serial, before P2G: mark the grid nodes covered by bodies as excluded
 //                                    from the WLS fits (Fig. 1b), e.g. through Grid::setExcluded
 //     ┌ parallel region (every thread runs each phase; worksharing loops inside) ─────────────────────┐
-//     │ p2g → gridUpdate → contact.apply(step) → g2p → gridMusl                                          │
+//     │ p2g → gridUpdate → contact.apply(step) → g2p → gridMusl            (MuslStep.hpp: gridPhases)   │
 //     └───────────────────────────────────────────────────────────────────────────────────────────────────┘
-//     updateStress → moveParticles
+//     updateStress → moveParticles                                           (MuslStep.hpp: particlePhases)
 //
-// apply() runs between gridUpdate and g2p: node lanes `a` hold the updated nodal velocities (Eq. 18),
-// `m` the lumped masses; a contact correction of the nodal velocity (Eqs. 23–26) is written into `a`
-// and the force applied into ContactNodes::force, from which the body reactions are summed.
+// apply() runs between gridUpdate and g2p: Grid::vel holds the updated nodal velocities (Eq. 18),
+// Grid::nodes the lumped masses m (and momentum p, force f of P2G); a contact correction of the nodal
+// velocity (Eqs. 23–26) is written into vel and the force applied into ContactNodes::force, from which
+// the body reactions are summed.
 // apply() is called by EVERY thread of the step's parallel region: use orphaned `#pragma omp for` loops
 // (their implicit barrier ends the phase), write each node from one thread only, and keep sums
 // deterministic (fixed order, e.g. per-thread partials combined in thread order, or the block colouring

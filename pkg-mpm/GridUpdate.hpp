@@ -1,4 +1,5 @@
-// The two grid phases of a step (paper Fig. 2), called by every thread of the solver's parallel region.
+// The grid update of a step (paper Fig. 2, Eq. 18; the MUSL remap is in MuslStep.hpp), called by every
+// thread of the solver's parallel region.
 #pragma once
 #include "Grid.hpp"
 
@@ -53,22 +54,6 @@ inline void dampAfterContact(Grid<D>& grid, Real dt, Real damping, Real massFloo
 				const Real v0 = grid.vold[i].c[a], f = nd.m * (grid.vel[i].c[a] - v0) / dt;
 				grid.vel[i].c[a] = (fix >> a) & 1 ? 0.0 : v0 + dt * cundallDamped(f, v0, damping) / nd.m;
 			}
-	}
-}
-
-// MUSL nodal velocities (Eqs. 16–17): vmusl ← mom / Σ w m, boundary planes again.
-template <int D>
-inline void gridMusl(Grid<D>& grid, Real massFloor)
-{
-	auto&      nodes = grid.nodes;
-	const Real mf    = massFloor;
-#pragma omp for schedule(static)
-	for (size_t i = 0; i < nodes.size(); ++i) {
-		const uint8_t fix = grid.fixMask[i];
-		const Real    inv = nodes[i].mw > mf ? 1.0 / nodes[i].mw : 0.0; // Eq. 17 denominator
-		NodeVec<D>    vn  = {};
-		for (int a = 0; a < D; ++a) vn.c[a] = (fix >> a) & 1 ? 0.0 : grid.mom[i].c[a] * inv;
-		grid.vmusl[i] = vn;
 	}
 }
 

@@ -1,18 +1,10 @@
-// Explicit WLS-MPM with MUSL (paper Sec. 2.5, Fig. 2). The solver owns the state and orchestrates one
-// step; the phases live in their own headers:
-//
-//   p2g            lumped mass, momentum, internal/external force      Eqs. 20–22    Transfer.hpp
-//   gridUpdate     nodal momentum balance with lumped mass, boundaries  Eq. 18        GridUpdate.hpp
-//   contact        PTS contact with rigid bodies (only with bodies)     Eqs. 23–26    ContactPhase.hpp
-//   g2p            particle velocity and gradient; MUSL remap           Eqs. 6–7, 16  Transfer.hpp
-//   gridMusl       nodal MUSL velocities                                Eqs. 16–17    GridUpdate.hpp
-//   updateStress   velocity gradient and constitutive update            Eqs. 7, 27–40 ParticleUpdate.hpp
-//   moveParticles  positions, stability and re-sort checks                            ParticleUpdate.hpp
+// Explicit WLS-MPM with MUSL (paper Sec. 2.5, Fig. 2). The solver owns the state (grid, particles, block
+// schedule, contact phase, clock), checks what a step reads and runs it: the step itself, phase by phase
+// with the paper's equations, reads in one place, MuslStep.hpp (P2G → grid update → contact → G2P →
+// MUSL remap → stress update → positions).
 #pragma once
-#include "ContactPhase.hpp"
-#include "GridUpdate.hpp"
 #include "MaterialSet.hpp"
-#include "ParticleUpdate.hpp"
+#include "MuslStep.hpp"
 #include "SolverSettings.hpp"
 #include <omp.h>
 
@@ -147,51 +139,18 @@ public:
 		double t0 = omp_get_wtime();
 		if (needSort || (steps % sortPeriod) == 0) sched.sort(grid, P), needSort = false;
 		errP2G.clear(), errContact.clear(), errG2P.clear();
-		ContactStep<D> cs { xfer, dt, time, massFloor, errContact };
-		const bool     withContact = contact.active();
-		const bool     mirrors     = grid.hasMirrors(); // symmetry planes: fold/unfold the reflected images
-		const bool     viewWrites  = liveViews > 0 || viewTaken; // P2G checks what views may have changed
-		if (withContact) contact.beforeTransfer(cs);
-		const Vec  g = gravity;
-		const Real s = loadScale(time);
-		double     t[6] = { omp_get_wtime() };
+		ContactStep<D>      cs { xfer, dt, time, massFloor, errContact };
+		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
+			                     liveViews > 0 || viewTaken }; // viewWrites: P2G checks what views may have changed
+		if (in.withContact) contact.beforeTransfer(cs);
+		double t[6] = { omp_get_wtime() };
 		materials.dispatch([&](const auto& mat) {
-			// The grid phases share one parallel region (a thread team is woken once per step, which matters
-			// on shared cores); every thread takes the same branches after the barrier ending each phase.
-#pragma omp parallel
-			{
-				xfer.p2g(mat, g, s, viewWrites, errP2G);
-				if (mirrors) grid.foldMirrors(grid.nodes); // symmetry planes: add the reflected images
-				stamp(t[1]);
-				if (errP2G.none()) {
-					const bool dampLate = withContact && damping > 0; // damp the net force, contact included
-					gridUpdate(grid, dt, dampLate ? 0 : damping, massFloor, dampLate);
-					stamp(t[2]);
-					if (withContact) {
-						contact.apply(cs);
-#pragma omp barrier
-						if (dampLate) dampAfterContact(grid, dt, damping, massFloor);
-					}
-					if (mirrors) grid.unfoldMirrors(grid.nodes), grid.unfoldMirrors(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
-					stamp(t[3]);
-					if (errContact.none()) {
-						xfer.g2p(errG2P);
-						if (errG2P.none()) {
-							if (mirrors) grid.foldMirrors(grid.mom);
-							gridMusl(grid, massFloor);
-							if (mirrors) grid.unfoldMirrors(grid.vmusl);
-						}
-					}
-				}
-				stamp(t[4]);
-			}
+			gridPhases(xfer, contact, cs, mat, in, errP2G, errContact, errG2P, t);       // MuslStep.hpp: phases 1–5
 			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
 			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
-			ErrorRecord errStress, errMove; // block by block: a block's particles move right after its stress update
-			const auto  st = updateStress(xfer, mat, dt, errStress, [&](uint32_t b, Real& v2max, int& drift) {
-				moveParticles(xfer, dt, b, v2max, drift, errMove); // while the block is in cache
-			});
+			ErrorRecord errStress, errMove;
+			const auto  st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
 			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
 			vmax = std::sqrt(st.v2max), rhoMin = st.rhoMin;
 			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
@@ -255,11 +214,6 @@ private:
 	ErrorRecord      errP2G, errContact, errG2P; // shared by the threads of the transfer region
 	std::string      failure;                    // message of a step that failed with particles partly updated
 
-	static void stamp(double& t)
-	{
-#pragma omp master
-		t = omp_get_wtime();
-	}
 	// After a failure in a phase that had already changed particles (partly), the state is not one of
 	// the scheme's states: further steps are refused until a checkpoint is restored (setResumeState).
 	void throwIf(const ErrorRecord& e, const char* phaseName, bool particlesChanged)
