@@ -262,11 +262,5 @@ struct ContactWrap {
 };
 } // namespace
 
-template <int D>
-void exposeContact(SolverClass<D>& cls, const char* name)
-{
-	ContactWrap<D>::expose(cls, name);
-}
-template void exposeContact<2>(SolverClass<2>&, const char*);
-template void exposeContact<3>(SolverClass<3>&, const char*);
+MPM_EXPOSE_SOLVER_PART(exposeContact, ContactWrap)
 } // namespace mpm

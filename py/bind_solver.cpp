@@ -220,13 +220,7 @@ struct SolverWrap {
 };
 } // namespace
 
-template <int D>
-void exposeSolverCore(SolverClass<D>& cls, const char* name)
-{
-	SolverWrap<D>::expose(cls, name);
-}
-template void exposeSolverCore<2>(SolverClass<2>&, const char*);
-template void exposeSolverCore<3>(SolverClass<3>&, const char*);
+MPM_EXPOSE_SOLVER_PART(exposeSolverCore, SolverWrap)
 // The class: created here, the other binding files add their methods.
 template <int D>
 void exposeSolver(const char* name)

@@ -102,11 +102,5 @@ struct StateWrap {
 };
 } // namespace
 
-template <int D>
-void exposeState(SolverClass<D>& cls, const char* name)
-{
-	StateWrap<D>::expose(cls, name);
-}
-template void exposeState<2>(SolverClass<2>&, const char*);
-template void exposeState<3>(SolverClass<3>&, const char*);
+MPM_EXPOSE_SOLVER_PART(exposeState, StateWrap)
 } // namespace mpm

@@ -143,11 +143,5 @@ struct ViewsWrap {
 };
 } // namespace
 
-template <int D>
-void exposeViews(SolverClass<D>& cls, const char* name)
-{
-	ViewsWrap<D>::expose(cls, name);
-}
-template void exposeViews<2>(SolverClass<2>&, const char*);
-template void exposeViews<3>(SolverClass<3>&, const char*);
+MPM_EXPOSE_SOLVER_PART(exposeViews, ViewsWrap)
 } // namespace mpm

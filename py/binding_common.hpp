@@ -57,4 +57,15 @@ void exposeContact(SolverClass<D>& cls, const char* name); // bind_contact.cpp: 
 void exposeMaterials();                                    // bind_materials.cpp: ElasticMat, DpGkMat, ContactParams
 void exposePointUpdate();                                  // bind_point.cpp: single-point DP–GK update, thresholds
 
+// Defines one of the exposeX above in its file: exposeX<D>(cls, name) calls Wrap<D>::expose(cls, name),
+// the file's struct of static methods, for D = 2 and 3.
+#define MPM_EXPOSE_SOLVER_PART(exposeX, Wrap)                                                               \
+	template <int D>                                                                                        \
+	void exposeX(SolverClass<D>& cls, const char* name)                                                     \
+	{                                                                                                       \
+		Wrap<D>::expose(cls, name);                                                                         \
+	}                                                                                                       \
+	template void exposeX<2>(SolverClass<2>&, const char*);                                                 \
+	template void exposeX<3>(SolverClass<3>&, const char*);
+
 } // namespace mpm
