@@ -85,7 +85,7 @@ def tunnel_numbers(folder, case):
     return dict(curve=c, at=at, end_mm=float(c[-1, 1]), finished=cj.get("finished"), steps=e.get("steps"), wall_s=e.get("wall_time_s"),
                 first_crack=fc and dict(time_ms=fc["time"] * 1e3, place=fc["location"], x_mm=fc["centroid"][0] * 1e3,
                                         y_mm=fc["centroid"][1] * 1e3),
-                penetration=_penetration_series(d, TUNNEL_WIDTH, float(e.get("grid_spacing_m", 0.002)) / 2))
+                penetration=_penetration_series(d, TUNNEL_WIDTH, e["grid_spacing_m"] / 2) if "grid_spacing_m" in e else [])
 
 
 def uniaxial_numbers(folder, run):
@@ -164,7 +164,7 @@ def tunnel_numbers(folder, case):
     return dict(curve=c, at=at, end_mm=float(c[-1, 1]), finished=cj.get("finished"), steps=e.get("steps"), wall_s=e.get("wall_time_s"),
                 first_crack=fc and dict(time_ms=fc["time"] * 1e3, place=fc["location"], x_mm=fc["centroid"][0] * 1e3,
                                         y_mm=fc["centroid"][1] * 1e3),
-                penetration=_penetration_series(d, TUNNEL_WIDTH, float(e.get("grid_spacing_m", 0.002)) / 2))
+                penetration=_penetration_series(d, TUNNEL_WIDTH, e["grid_spacing_m"] / 2) if "grid_spacing_m" in e else [])
 
 
 def uniaxial_numbers(folder, run):
