@@ -342,7 +342,13 @@ def fidelity_section(R):
     n = {}
     for r in rows:
         n[r["verdict"].split(":")[0]] = n.get(r["verdict"].split(":")[0], 0) + 1
-    R.w("", "Default grid: " + ", ".join(f"{v} {k}" for k, v in sorted(n.items())) + f" of {len(rows)} rows.", "")
+    npg = {}
+    for r in rows:
+        k = r["verdict_paper"].split(":")[0]
+        if k not in ("—", "not run"):
+            npg[k] = npg.get(k, 0) + 1
+    R.w("", "Default grid: " + ", ".join(f"{v} {k}" for k, v in sorted(n.items())) + f" of {len(rows)} rows."
+        + (" Paper grid: " + ", ".join(f"{v} {k}" for k, v in sorted(npg.items())) + f" of the {sum(npg.values())} rows run there." if npg else ""), "")
 
 
 def variant_matrix(R, folder="fidelity_variants"):
