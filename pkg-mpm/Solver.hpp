@@ -169,6 +169,7 @@ public:
 	Real   elasticEnergy() const { return materials.elasticEnergy(P); } // stored by the effective stress [J]
 	Sym<D> effectiveStress(size_t p) const { return materials.effectiveStress(P, p); } // damaged for DP–GK (Eq. 40)
 	Real   cohesion(size_t p) const { return materials.cohesion(P, p); }               // Eq. 34; NaN if not DP–GK
+	bool   materialVelocity(size_t p, Real (&v)[D]) const { return xfer.materialVelocity(p, v); } // at x_p (Transfer.hpp)
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
 	Real maxSpeed() // max ‖v‖ [m/s], refreshed after requestSort()
 	{

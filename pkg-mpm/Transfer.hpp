@@ -228,6 +228,22 @@ public:
 		return true;
 	}
 
+	// Velocity of the material point x_p: v_p + C_p (x_p − x̄_p). A cut stencil's v_p is the velocity at x̄_p (g2p:
+	// Σ_p m_p v_p is the grid's momentum), so the material point moves with this one (updateStress); x̄_p from the
+	// current positions and node exclusions (those of the last step until the next one starts). False: singular fit.
+	bool materialVelocity(size_t p, Real (&v)[D]) const
+	{
+		Kernel<D> k;
+		kernelOf(p, k);
+		for (int a = 0; a < D; ++a) v[a] = P.v[a][p];
+		if (!k.inside || !k.general) return true; // interior: x̄_p = x_p; outside the grid: v_p as stored
+		Stencil<D> st;
+		if (!fillStencil(grid, offs, k, st)) return false;
+		for (int a = 0; a < D; ++a)
+			for (int b = 0; b < D; ++b) v[a] -= P.C[a * D + b][p] * st.dbar[b];
+		return true;
+	}
+
 	std::string positionText(size_t p) const
 	{
 		std::string t = "(";

@@ -57,6 +57,18 @@ struct ViewsWrap {
 		}
 		return out;
 	}
+	// Velocity of each material point, v_p + C_p (x_p − x̄_p) (Transfer::materialVelocity), shape (N, D), copied.
+	static np::ndarray materialVelocity(S& s)
+	{
+		np::ndarray out = np::empty(bp::make_tuple(s.P.n, D), np::dtype::get_builtin<double>());
+		auto*       o   = reinterpret_cast<double*>(out.get_data());
+		for (size_t p = 0; p < s.P.n; ++p) {
+			Real v[D];
+			if (!s.materialVelocity(p, v)) throw SimulationError("materialVelocity: particle " + std::to_string(s.P.id[p]) + " has a singular WLS fit");
+			for (int a = 0; a < D; ++a) o[p * D + a] = v[a];
+		}
+		return out;
+	}
 	static np::ndarray maxPrincipalStress(S& s)
 	{
 		np::ndarray out = np::empty(bp::make_tuple(s.P.n), np::dtype::get_builtin<double>());
@@ -135,6 +147,7 @@ struct ViewsWrap {
 		cls.def("view", &view, bp::arg("name"))
 		        .def("effectiveStress", &effectiveStress)
 		        .def("maxPrincipalStress", &maxPrincipalStress)
+		        .def("materialVelocity", &materialVelocity, "Velocity of each material point [m/s], (N, D), storage order: v + C (x − x̄), x̄ the centroid of a cut stencil's lumping weights.")
 		        .def("shapeFunctions", &shapeFunctions, bp::arg("point"))
 		        .def("nodePositions", &nodePositions)
 		        .def("nodeState", &nodeState)

@@ -22,7 +22,10 @@ SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz"
 FIELDS = {
     "id": ("id", "-", "particle id (add_region's return values)"),
     "pos": ("x", "m", "position, (N, D)"),
-    "vel": ("v", "m/s", "velocity, (N, D)"),
+    "vel": ("materialVelocity()", "m/s", "velocity of the material point, (N, D): the particle moves with it; next to a "
+            "body (cut WLS stencil) v_p + C_p (x_p − x̄_p), see 'momentum'"),
+    "momentum": ("mass·v", "kg·m/s", "momentum m_p v_p, (N, D): Σ over the particles is the total momentum exactly (the "
+                 "grid's); v_p = momentum/mass equals vel except next to a body, where it is the velocity at x̄_p"),
     "stress": ("effectiveStress()", "Pa", "stress carried, damaged for DP–GK (Eq. 40); (N, 4) xx, yy, zz, xy in 2D, "
                "(N, 6) xx, yy, zz, xy, xz, yz in 3D; tension positive"),
     "undamaged_stress": ("sig", "Pa", "stress of the undamaged material (the constitutive state, Eqs. 26–33); "
@@ -73,7 +76,7 @@ def id_order(solver):
 
 def get(solver, name, order=None):
     """Copy of the particle field `name` in particle-id order (row k = particle id k). Names (``FIELDS``):
-    id, pos, vel [m, m/s], stress (carried, damaged for DP–GK) and undamaged_stress [Pa] (xx, yy, zz, xy[,
+    id, pos, vel [m, m/s] (of the material point), momentum [kg·m/s] (sums to the total exactly), stress (carried, damaged for DP–GK) and undamaged_stress [Pa] (xx, yy, zz, xy[,
     xz, yz], tension positive), max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass
     [kg], volume [m³], material. Pass order=id_order(solver) when reading several fields of one state."""
     d = dim_of(solver)
@@ -81,8 +84,12 @@ def get(solver, name, order=None):
         hint = f" (use '{_RENAMED[name]}')" if name in _RENAMED else ""
         raise ValueError(f"unknown field {name!r}{hint}; fields: {', '.join(FIELDS)}")
     o = id_order(solver) if order is None else order
-    if name in ("pos", "vel"):
-        return np.column_stack([solver.view(f"{FIELDS[name][0]}{a}") for a in range(d)])[o]
+    if name == "pos":
+        return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
+    if name == "vel":
+        return solver.materialVelocity()[o]
+    if name == "momentum":
+        return (solver.view("mass")[:, None] * np.column_stack([solver.view(f"v{a}") for a in range(d)]))[o]
     if name == "stress":
         return solver.effectiveStress()[o]
     if name == "undamaged_stress":
