@@ -149,13 +149,15 @@ def test_block_on_rotating_plate_follows_it(omega):
           f"{np.mean(E > 0.05):.5f}, particles ever > 5 %: {np.flatnonzero((E > 0.05).any(0)).tolist()}; "
           f"m v/m (at x̄_p) worst {max(ES):.4f}")
     assert turned / angle == pytest.approx(1.0, abs=0.005)
-    # `vel` is the velocity of the material point (fields.py), the quantity of the bar. The bar (5 % at every step)
-    # is NOT met next to the block's bottom corners at ω = ±1: measured worst 0.42 (+1) and 1.70 (−1) of ω r, the
-    # corner particle above 5 % in ~20 % of the steps, a few neighbours in ≤ 10 % (ω = ±2: see doc/contact.md); its
-    # WLS velocity gradient oscillates with a period of 3 steps (doc/contact.md, "Which velocity a particle
-    # reports"). Every other particle meets it at every step; m v/m, the velocity at x̄_p, is 8–21 % off there.
-    # Asserted: the bar on the median step, at most 0.5 % of the (particle, step) samples above it (measured 0.15 %),
-    # and no blow-up (before issue 17: 18× and 184× ω r).
+    # `vel` is the velocity of the material point (fields.py), the quantity of the bar. At ω = ±2 the bar (5 % at every
+    # step) is met (measured worst 0.027, 0.026; m v/m, the velocity at x̄_p, 0.119 and 0.120: the whole error of
+    # before was where the velocity was read). At ω = ±1 it is NOT met next to the block's bottom corners: worst
+    # 0.42 (+1) and 1.70 (−1) of ω r, the corner particle above 5 % in ~20 % of the steps, a few neighbours in ≤ 10 %;
+    # its WLS velocity gradient oscillates with a period of 3 steps (doc/contact.md, "Which velocity a particle
+    # reports"). There asserted: the bar on the median step, at most 0.5 % of the (particle, step) samples above it
+    # (measured 0.15 %), and no blow-up (before issue 17: 18× and 184× ω r).
+    if abs(omega) == 2.0:
+        assert E.max() <= 0.05
     assert np.median(E.max(1)) <= 0.05
     assert np.mean(E > 0.05) <= 0.005
     assert E.max() <= 2.5
