@@ -4,8 +4,8 @@ Next to a body the WLS fit runs over the active nodes only and its ψ_i extrapol
 lumped masses are taken with the non-negative weights ξ_i = w_i/Σ w (WlsShape.hpp), so no node mass is
 negative or vanishes and no corner particle blows up. Bars of the issue:
 - sliding: |a/a_exact − 1| ≤ 3 % for every θ/μ/shift, a_exact = g(sin θ − μ cos θ);
-- sticking from gravity equilibrium: drift ≤ 1 % of a cell over 0.3 s (2D; 3D over 0.15 s) — not met 4 % below
-  the friction limit (see STICKING);
+- sticking from gravity equilibrium: drift ≤ 1 % of a cell over 0.3 s (2D; 3D over 0.15 s); 4 % below the friction
+  limit from the block's own equilibrium (from a long layer's stress it creeps: see STICKING);
 - no run stops, no particle lifts off the slope by more than 0.1 cell;
 - a block on a plate rotating at ±1 and ±2 rad/s follows it: block angle within 0.5 % of the plate's,
   material-point velocities (`vel`) within 5 % of ω × r after the ramp (not met next to the bottom corners at
@@ -70,29 +70,33 @@ def test_sliding_acceleration_on_every_grid_shift(d, theta, mu):
     assert np.max(lifts) <= 0.1
 
 
-STICKING = [(2, 20, 0.5, 0.01), (3, 20, 0.5, 0.01),
-            # 4 % below the friction limit (tan 30° = 0.577 < 0.6) the block creeps from the long layer's stress
-            # (prestress=True): 0.14–0.28 cell over 0.3 s on the 8 shifts, 0.30 cell over 0.5 s on shift 0 at a steady
-            # rate (the issue's bar, 1 % of a cell, is not met from this start). That stress is not the finite block's
-            # equilibrium (the layer's σ_tn acts on its free ends): the release starts elastic vibrations that nothing
-            # damps, and at 96 % of the limit each cycle slips a little downhill (with s.damping = 0.3 the same start
-            # stops within 2e-4 cell). From the block's own equilibrium (0.1 s with damping 0.3, then undamped) shift 0
-            # drifts 1.2e-4 cell over 0.3 s (doc/contact.md, "Sticking near the friction limit"); not yet run on all
-            # 8 shifts, so this start keeps the layer's stress, guarded at half a cell.
-            (2, 30, 0.6, 0.5)]
+STICKING = [(2, 20, 0.5, 0.01, 0.0), (3, 20, 0.5, 0.01, 0.0),
+            # 4 % below the friction limit (tan 30° = 0.577 < 0.6) from the long layer's stress (prestress=True) the
+            # block creeps: 0.14–0.28 cell over 0.3 s on the 8 shifts, 0.30 cell over 0.5 s on shift 0, at a steady rate.
+            # That stress is not the finite block's equilibrium (the layer's σ_tn acts on the block's free ends): the
+            # release sets up elastic vibrations that nothing damps, and at 96 % of the limit each cycle slips a little
+            # downhill (vibration ratcheting; with s.damping = 0.3 the same start stops within 2e-4 cell). From the block's
+            # own gravity equilibrium (reached with damping 0.3 over 0.05 s, then undamped) it holds: the bar (measured
+            # 1e-5 to 1.1e-4 cell over 0.3 s on the 8 shifts).
+            (2, 30, 0.6, 0.01, 0.05)]
 
 
-@pytest.mark.parametrize("d,theta,mu,limit", STICKING)
-def test_sticking_from_equilibrium_on_every_grid_shift(d, theta, mu, limit):
+@pytest.mark.parametrize("d,theta,mu,limit,relax", STICKING)
+def test_sticking_from_equilibrium_on_every_grid_shift(d, theta, mu, limit, relax):
     th = np.radians(theta)
     assert np.tan(th) < mu
     drifts, lifts = [], []
     for sh in SHIFTS:
         s, R, c0, l = _block(d, th, mu, sh, prestress=True)
-        h, lift = _run(s, d, R, c0, l, 0.3 if d == 2 else 0.15)
+        if relax:                                   # to the block's own equilibrium, then no damping
+            s.damping = 0.3
+            while s.time < relax:
+                s.step()
+            s.damping = 0.0
+        h, lift = _run(s, d, R, c0, l, relax + (0.3 if d == 2 else 0.15))
         drifts.append(np.abs(h[:, 1] - h[0, 1]).max() / l)
         lifts.append(lift / l)
-    print(f"d={d} θ={theta} μ={mu}: drift [cells] = {np.round(drifts, 4)}, lift [cells] = {np.round(lifts, 3)}")
+    print(f"d={d} θ={theta} μ={mu}: drift [cells] = {np.round(drifts, 5)}, lift [cells] = {np.round(lifts, 3)}")
     assert np.max(drifts) <= limit
     assert np.max(lifts) <= 0.1
 
