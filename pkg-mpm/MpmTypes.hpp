@@ -37,6 +37,7 @@ struct SimulationError : std::runtime_error {
 // First failure of a parallel particle pass. The lowest particle slot wins, so the message is the same
 // for any thread count; threads record and go on, the caller throws after the pass (SimulationError).
 struct ErrorRecord {
+	static constexpr size_t elsewhere = SIZE_MAX - 1; // MPI build: the phase failed on another rank
 	size_t      particle = SIZE_MAX;
 	std::string what;
 	void        clear() { particle = SIZE_MAX, what.clear(); }

@@ -63,14 +63,21 @@ inline void stampTime(double& t)
 // cores): every thread calls each phase, whose worksharing loops end with a barrier, and every thread
 // takes the same branches. A phase that recorded a failure (errP2G, errContact, errG2P) ends the region;
 // the caller throws. t[1..4]: wall clock after P2G, grid update, contact, G2P + MUSL remap.
-template <int D, class Mat>
+// sumShared(field, err, phase): MPI build, adds the neighbour ranks' partial sums of the shared nodes
+// (HaloExchange.hpp); the serial build passes NoExchange, which is empty.
+struct NoExchange {
+	template <class F>
+	void operator()(F&, ErrorRecord&, const char*) const { }
+};
+template <int D, class Mat, class Exchange = NoExchange>
 inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<D>& cs, const Mat& mat, const StepInputs<D>& in,
-                       ErrorRecord& errP2G, ErrorRecord& errContact, ErrorRecord& errG2P, double (&t)[6])
+                       ErrorRecord& errP2G, ErrorRecord& errContact, ErrorRecord& errG2P, double (&t)[6], Exchange&& sumShared = Exchange {})
 {
 	Grid<D>& grid = xfer.grid;
 #pragma omp parallel
 	{
 		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, errP2G); // 1: Eqs. 20–22
+		sumShared(grid.nodes, errP2G, "P2G");                            // MPI: + neighbours' partial sums
 		if (in.mirrors) grid.foldMirrors(grid.nodes);                    // symmetry planes: add the reflected images
 		stampTime(t[1]);
 		if (errP2G.none()) {
@@ -86,6 +93,7 @@ inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<
 			stampTime(t[3]);
 			if (errContact.none()) {
 				xfer.g2p(errG2P); // 4: Eqs. 6–7, MUSL momentum (Eq. 16)
+				sumShared(grid.mom, errG2P, "G2P"); // MPI: + neighbours' partial sums
 				if (errG2P.none()) {
 					if (in.mirrors) grid.foldMirrors(grid.mom);
 					gridMusl(grid, in.massFloor); // 5: Eq. 17

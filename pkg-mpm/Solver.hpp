@@ -3,6 +3,7 @@
 // with the paper's equations, reads in one place, MuslStep.hpp (P2G → grid update → contact → G2P →
 // MUSL remap → stress update → positions).
 #pragma once
+#include "Decomposition.hpp"
 #include "MaterialSet.hpp"
 #include "MuslStep.hpp"
 #include "SolverSettings.hpp"
@@ -31,6 +32,7 @@ public:
 	ContactPhase<D> contact;
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
+	MPM_IF_MPI(Decomposition<D> dd;) // MPI build only: slabs, migration, shared-node sums (Decomposition.hpp)
 
 	// Arrays handed out without copy (NumPy views, binding layer): appending must not move them, and P2G
 	// checks what they may have changed (reach, mass, volume) while one is alive or was taken since the step.
@@ -47,6 +49,7 @@ public:
 	void addParticles(const Real* x, const Real* vol, const Real* mass, size_t n, long material = 0)
 	{
 		materials.checkIndex(material);
+		MPM_IF_MPI(dd.refuseAfterSplit("addParticles");) // every rank would add them: duplicates
 		if (liveViews && !P.fits(n))
 			throw InputError("addParticles: " + std::to_string(liveViews) + " NumPy view(s) of the particle arrays are alive and adding " + std::to_string(n)
 			                 + " particles would move the arrays they point to; delete the views first (del v), or call reserve(total particles) before taking them");
@@ -136,8 +139,12 @@ public:
 		if (dt > lim * (1 + 1e-12))
 			throw InputError("dt = " + fmtNum(dt) + " s exceeds the stable time step " + fmtNum(lim) + " s (Δt ≤ C·l/(v_c + max‖v‖), C = "
 			                 + fmtNum(courant) + "); lower dt or switch autoDt on");
+		MPM_IF_MPI(dd.checkStep(contact.active(), liveViews);)
 		double t0 = omp_get_wtime();
-		if (needSort || (steps % sortPeriod) == 0) sched.sort(grid, P), needSort = false;
+		if (needSort || (steps % sortPeriod) == 0 MPM_IF_MPI(|| dd.needsSplit())) {
+			MPM_IF_MPI(dd.migrate(grid, P);) // particles that left the rank's slab go to its neighbour
+			sched.sort(grid, P), needSort = false;
+		}
 		errP2G.clear(), errContact.clear(), errG2P.clear();
 		ContactStep<D>      cs { xfer, dt, time, massFloor, errContact };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
@@ -145,12 +152,13 @@ public:
 		if (in.withContact) contact.beforeTransfer(cs);
 		double t[6] = { omp_get_wtime() };
 		materials.dispatch([&](const auto& mat) {
-			gridPhases(xfer, contact, cs, mat, in, errP2G, errContact, errG2P, t);       // MuslStep.hpp: phases 1–5
+			gridPhases(xfer, contact, cs, mat, in, errP2G, errContact, errG2P, t MPM_IF_MPI(, [&](auto& f, ErrorRecord& e, const char* ph) { if (dd.distributed()) dd.halo.sum(dd.layout, grid, dd.rank, f, e, ph); }));       // MuslStep.hpp: phases 1–5
 			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
 			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
 			ErrorRecord errStress, errMove;
-			const auto  st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
+			auto        st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
+			MPM_IF_MPI(dd.reduceStep(st.rhoMin, st.v2max, st.drift, errStress, errMove);) // global Δt limits, re-sort flag
 			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
 			vmax = std::sqrt(st.v2max), rhoMin = st.rhoMin;
 			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
@@ -190,6 +198,7 @@ public:
 	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, rhoMin, massFloor, needSort, needCheck }; }
 	void setResumeState(const ResumeState& r, const std::vector<uint32_t>& blockStart)
 	{
+		MPM_IF_MPI(dd.refuseAfterSplit("setResumeState (checkpoint resume)");)
 		const long s0 = steps;
 		const Real t0 = time, w0 = externalWork;
 		setClock(r.steps, r.time, r.externalWork); // checked before anything else changes
@@ -220,8 +229,8 @@ private:
 	void throwIf(const ErrorRecord& e, const char* phaseName, bool particlesChanged)
 	{
 		if (e.none()) return;
-		const std::string what = "MPM stopped at step " + std::to_string(steps) + " (t = " + fmtNum(time) + " s) in " + phaseName + ": particle id "
-		                         + std::to_string(P.id[e.particle]) + " " + e.what;
+		const std::string who  = e.particle < P.n ? "particle id " + std::to_string(P.id[e.particle]) + " " : "";
+		const std::string what = "MPM stopped at step " + std::to_string(steps) + " (t = " + fmtNum(time) + " s) in " + phaseName + ": " + who + e.what;
 		if (particlesChanged) failure = what;
 		throw SimulationError(what);
 	}
@@ -229,24 +238,36 @@ private:
 	// Validation that must precede any work; cheap when nothing changed.
 	void prepare()
 	{
-		if (P.n == 0) throw InputError("particles: no particles in the solver; add particles before stepping");
+		if (P.n == 0 MPM_IF_MPI(&&!dd.decomposed)) throw InputError("particles: no particles in the solver; add particles before stepping");
 		if (materials.size() == 0) throw InputError("material: no material assigned; set a material before stepping");
 		if (!std::isfinite(rhoMin) || needCheck) {
 			// State edited through the live views (requestSort() after editing) is validated like
 			// addParticles input: a NaN or off-grid position would index outside the node arrays.
-			const auto c = P.check(grid.allowedLo, grid.allowedHi, materials.size()); // the grid cut by the boundary planes
-			P.checkDamageState([&](size_t p) { // ε_D⁰ is checked where the particle's material has damage on
-				const auto& e = materials.of(P, p);
-				return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
-			});
-			rhoMin       = materials.single() ? c.rhoMin : materials.minDtDensity(P);
-			vmax         = c.vmax; // also lowered when velocities were lowered through the views
-			massFloor    = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)
-			needCheck    = false;
+			auto validate = [&] {
+				const auto c = P.check(grid.allowedLo, grid.allowedHi, materials.size()); // the grid cut by the boundary planes
+				P.checkDamageState([&](size_t p) { // ε_D⁰ is checked where the particle's material has damage on
+					const auto& e = materials.of(P, p);
+					return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
+				});
+				rhoMin    = materials.single() ? c.rhoMin : materials.minDtDensity(P);
+				vmax      = c.vmax; // also lowered when velocities were lowered through the views
+				massFloor = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)
+			};
+#ifdef MPM_MPI
+			dd.agree(validate), dd.reduceLimits(rhoMin, vmax, massFloor); // every rank stops if one fails; global limits
+#else
+			validate();
+#endif
+			needCheck = false;
 		}
 	}
 
-	void accumulateExternalWork(Real dt) { externalWork += P.externalWork(gravity, loadScale(time + dt), dt); }
+	void accumulateExternalWork(Real dt)
+	{
+		Real w = P.externalWork(gravity, loadScale(time + dt), dt);
+		MPM_IF_MPI(w = dd.sum(w);) // MPI: the work on every rank's particles
+		externalWork += w;
+	}
 };
 
 } // namespace mpm

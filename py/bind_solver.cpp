@@ -231,6 +231,7 @@ void exposeSolver(const char* name)
 	exposeState<D>(cls, name);
 	exposeViews<D>(cls, name);
 	exposeContact<D>(cls, name);
+	MPM_IF_MPI(exposeMpi<D>(cls, name);)
 }
 template void exposeSolver<2>(const char*);
 template void exposeSolver<3>(const char*);

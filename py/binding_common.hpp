@@ -56,6 +56,11 @@ template <int D>
 void exposeContact(SolverClass<D>& cls, const char* name); // bind_contact.cpp: rigid parts and contact groups
 void exposeMaterials();                                    // bind_materials.cpp: ElasticMat, DpGkMat, ContactParams
 void exposePointUpdate();                                  // bind_point.cpp: single-point DP–GK update, thresholds
+#ifdef MPM_MPI
+template <int D>
+void exposeMpi(SolverClass<D>& cls, const char* name); // bind_mpi.cpp (MPI build): decomposition info
+void initMpi();                                        // bind_mpi.cpp: MPI_Init_thread, finalize at exit
+#endif
 
 // Defines one of the exposeX above in its file: exposeX<D>(cls, name) calls Wrap<D>::expose(cls, name),
 // the file's struct of static methods, for D = 2 and 3.

@@ -25,10 +25,16 @@ int getThreads() { return omp_get_max_threads(); }
 
 } // namespace
 
-BOOST_PYTHON_MODULE(_core)
+#ifdef MPM_MPI
+#define MPM_MODULE _core_mpi // the MPI build of the same sources (doc/scaling.md)
+#else
+#define MPM_MODULE _core
+#endif
+BOOST_PYTHON_MODULE(MPM_MODULE)
 {
 	Py_Initialize();
 	np::initialize();
+	MPM_IF_MPI(initMpi();)
 	simulationErrorType = PyErr_NewException("yade_mpm._core.MpmSimulationError", PyExc_RuntimeError, nullptr);
 	bp::scope().attr("MpmSimulationError") = bp::handle<>(bp::borrowed(simulationErrorType));
 	bp::register_exception_translator<InputError>(&translateInput);

@@ -1,0 +1,175 @@
+// MPI domain decomposition of one scene (MPI build only, module yade_mpm._core_mpi; doc/scaling.md).
+// Every rank runs the same script and builds the same scene; at the first step each rank keeps the
+// particles of its slab (SlabLayout: whole block layers along the last axis, boundaries from the particle
+// counts) and drops the others. From then on:
+//   re-sort      particles whose block layer belongs to a neighbour migrate to it with all their fields
+//                (before the counting sort; a re-sort is triggered on every rank when one needs it)
+//   P2G, G2P     partial sums of the shared node bands exchanged and added (HaloExchange.hpp)
+//   Δt           ρ_min, max ‖v‖ and the mass floor are global (min / max over ranks): the same Δt everywhere
+//   failures     a phase that failed on one rank stops every rank at the same point
+// Each rank holds the whole grid arrays but its particles touch only its reach (SlabLayout::reachedLayers).
+#pragma once
+#include "HaloExchange.hpp"
+
+#ifdef MPM_MPI
+namespace mpm {
+
+template <int D>
+class Decomposition {
+public:
+	const int       rank = Comm::rank(), R = Comm::size();
+	SlabLayout<D>   layout;
+	HaloExchange<D> halo;
+	bool            decomposed = false;
+	size_t          migrated   = 0; // particles sent by this rank since the split
+
+	bool distributed() const { return R > 1; }
+
+	// Refuses, before any work, what this build does not distribute yet (the same answer on every rank).
+	void checkStep(bool contactActive, size_t liveViews) const
+	{
+		if (!distributed()) return;
+		if (contactActive)
+			throw InputError("MPI: rigid bodies (contact) are not distributed yet (issue 22, doc/scaling.md); run scenes with bodies on 1 rank");
+		if (liveViews)
+			throw InputError("MPI: " + std::to_string(liveViews) + " NumPy view(s) of the particle arrays are alive; particles migrate between ranks and the "
+			                 "arrays change length: delete the views before stepping (del v) and take new ones after");
+	}
+
+	// Before the counting sort: the first call splits the (replicated) scene, later calls migrate.
+	void migrate(const Grid<D>& g, Particles<D>& P)
+	{
+		if (!distributed()) return;
+		if (!decomposed) return split(g, P);
+		std::vector<uint8_t> go(P.n, 0); // 0: stays, 1: to rank − 1, 2: to rank + 1
+		bool                 ok = true;
+		size_t               nd = 0, nu = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			const int o = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p]));
+			if (o == rank) continue;
+			ok = ok && (o == rank - 1 || o == rank + 1);
+			go[p] = o < rank ? 1 : 2;
+			(o < rank ? nd : nu) += 1;
+		}
+		if (!Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
+		const size_t nf = fieldCount(P);
+		std::vector<double> sd, su, rd(1), ru(1), cd { double(nd) }, cu { double(nu) };
+		Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
+		const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
+		sd.reserve(nd * nf), su.reserve(nu * nf);
+		for (size_t p = 0; p < P.n; ++p)
+			if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
+		rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
+		Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
+		keep(P, go);
+		unpack(P, rd, ad, nf), unpack(P, ru, au, nf); // arrivals from below, then from above: a fixed order
+		migrated += nd + nu;
+	}
+
+	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.
+	void reduceLimits(Real& rhoMin, Real& vmax, Real& massFloor) const
+	{
+		if (!distributed()) return;
+		double v[3] = { -rhoMin, vmax, -massFloor };
+		Comm::max(v, 3);
+		rhoMin = -v[0], vmax = v[1], massFloor = -v[2];
+	}
+	// End of step: global ρ_min, max ‖v‖², re-sort flag; a failure of the particle pass on any rank stops all.
+	void reduceStep(Real& rhoMin, Real& v2max, int& drift, ErrorRecord& errStress, ErrorRecord& errMove) const
+	{
+		if (!distributed()) return;
+		double v[4] = { -rhoMin, v2max, double(drift), errStress.none() && errMove.none() ? 0.0 : 1.0 };
+		Comm::max(v, 4);
+		rhoMin = -v[0], v2max = v[1], drift = int(v[2]);
+		if (v[3] > 0 && errStress.none() && errMove.none())
+			errMove.record(ErrorRecord::elsewhere, "stopped: the stress or position update of another MPI rank failed (its message names the particle)");
+	}
+	// Runs a validation on every rank; if it threw on any, every rank throws (its own message or a pointer to it).
+	template <class F>
+	void agree(F&& validate) const
+	{
+		std::string bad;
+		try {
+			validate();
+		} catch (const InputError& e) {
+			bad = e.what();
+		}
+		if (Comm::all(bad.empty())) return;
+		throw InputError(bad.empty() ? "MPI: the particle check failed on another rank (its message names the particle)" : bad);
+	}
+	Real sum(Real v) const
+	{
+		if (distributed()) Comm::sum(&v, 1);
+		return v;
+	}
+
+private:
+	// First step: the same particles on every rank (checked: count and a position checksum); slabs from
+	// the particle counts per block layer; each rank keeps its own.
+	void split(const Grid<D>& g, Particles<D>& P)
+	{
+		double s = 0;
+		for (size_t p = 0; p < P.n; ++p) s += P.x[D - 1][p] + 0.5 * P.x[0][p] + 1e-3 * double(P.id[p]);
+		double hiv[3] = { double(P.n), s, double(fieldCount(P)) }, lov[3] = { -hiv[0], -hiv[1], -hiv[2] };
+		Comm::max(hiv, 3), Comm::max(lov, 3);
+		if (hiv[0] != -lov[0] || hiv[1] != -lov[1] || hiv[2] != -lov[2])
+			throw InputError("MPI: every rank must build the same scene before the first step (the script runs on every rank); the ranks hold "
+			                 "different particles (counts " + fmtNum(-lov[0]) + " to " + fmtNum(hiv[0]) + ")");
+		const int           L = SlabLayout<D>::layers(g);
+		std::vector<double> count(size_t(L), 0.0);
+		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
+		layout = SlabLayout<D>::balanced(count, R);
+		layout.checkMirrors(g);
+		std::vector<uint8_t> go(P.n, 0);
+		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
+		keep(P, go);
+		decomposed = true;
+	}
+	static size_t fieldCount(Particles<D>& P)
+	{
+		size_t n = 2; // id, material
+		P.forEachRealField([&](std::vector<Real>&) { ++n; });
+		return n;
+	}
+	static void pack(Particles<D>& P, size_t p, std::vector<double>& buf)
+	{
+		P.forEachRealField([&](std::vector<Real>& f) { buf.push_back(f[p]); });
+		double id;
+		std::memcpy(&id, &P.id[p], sizeof id); // the 64 bits as they are
+		buf.push_back(id), buf.push_back(double(P.mat[p]));
+	}
+	// Keeps the particles with go[p] == 0, in their order.
+	static void keep(Particles<D>& P, const std::vector<uint8_t>& go)
+	{
+		size_t k = 0;
+		auto   compact = [&](auto& f) {
+			k = 0;
+			for (size_t p = 0; p < P.n; ++p)
+				if (!go[p]) f[k++] = f[p];
+			f.resize(k);
+		};
+		P.forEachRealField(compact);
+		compact(P.id), compact(P.mat);
+		P.n = k;
+	}
+	static void unpack(Particles<D>& P, const std::vector<double>& buf, size_t count, size_t nf)
+	{
+		if (!count) return;
+		const size_t n0 = P.n;
+		P.n += count;
+		size_t i = 0; // field index, in pack's order
+		P.forEachRealField([&](std::vector<Real>& f) {
+			f.resize(P.n);
+			for (size_t j = 0; j < count; ++j) f[n0 + j] = buf[j * nf + i];
+			++i;
+		});
+		P.id.resize(P.n), P.mat.resize(P.n);
+		for (size_t j = 0; j < count; ++j) {
+			std::memcpy(&P.id[n0 + j], &buf[j * nf + i], sizeof(int64_t));
+			P.mat[n0 + j] = uint8_t(buf[j * nf + i + 1]);
+		}
+	}
+};
+
+} // namespace mpm
+#endif

@@ -1,0 +1,61 @@
+// MPI build only (module yade_mpm._core_mpi, -DMPM_MPI): start-up of MPI and what Python may ask about
+// the decomposition (pkg-mpm/Decomposition.hpp, doc/scaling.md).
+#include "binding_common.hpp"
+
+#ifdef MPM_MPI
+namespace mpm {
+namespace {
+
+bool startedHere = false;
+void finalize()
+{
+	int done = 0;
+	MPI_Finalized(&done);
+	if (startedHere && !done) MPI_Finalize();
+}
+
+template <int D>
+bp::dict mpiInfo(Solver<D>& s)
+{
+	bp::dict d;
+	d["rank"] = s.dd.rank, d["size"] = s.dd.R, d["decomposed"] = s.dd.decomposed;
+	bp::list first;
+	for (int f : s.dd.layout.first) first.append(f);
+	d["firstLayers"]   = first; // block layers (8 cells) along the last axis owned by rank r: [first[r], first[r+1])
+	d["particles"]     = s.P.n;  // on this rank
+	d["migrated"]      = s.dd.migrated;
+	d["haloBytesSent"] = s.dd.halo.bytesLastStep; // per shared-node exchange (two per step)
+	return d;
+}
+
+int rank() { return Comm::rank(); }
+int size() { return Comm::size(); }
+
+} // namespace
+
+// MPI_Init_thread at import (one thread per rank calls MPI: FUNNELED); MPI_Finalize when Python exits.
+void initMpi()
+{
+	int on = 0;
+	MPI_Initialized(&on);
+	if (!on) {
+		int provided = 0;
+		MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+		startedHere = true;
+		if (provided < MPI_THREAD_FUNNELED) throw SimulationError("MPI: the library does not provide MPI_THREAD_FUNNELED (needed with OpenMP threads)");
+		Py_AtExit(&finalize);
+	}
+	bp::def("mpiRank", &rank, "This process's rank in MPI_COMM_WORLD.");
+	bp::def("mpiSize", &size, "Number of MPI ranks.");
+}
+
+template <int D>
+void exposeMpi(SolverClass<D>& cls, const char*)
+{
+	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, haloBytesSent.");
+}
+template void exposeMpi<2>(SolverClass<2>&, const char*);
+template void exposeMpi<3>(SolverClass<3>&, const char*);
+
+} // namespace mpm
+#endif

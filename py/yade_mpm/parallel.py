@@ -1,0 +1,55 @@
+"""MPI domain decomposition (doc/scaling.md): which compiled core ``import yade_mpm`` loads, and this
+process's rank.
+
+The serial module ``yade_mpm._core`` is what ``import yade_mpm`` loads by default. The MPI build of the
+same sources, ``yade_mpm._core_mpi`` (compiled with -DMPM_MPI when an MPI library is found), is loaded
+instead when
+
+- ``YADE_MPM_MPI=1`` is set (``YADE_MPM_MPI=0`` forces the serial core), or
+- the process was started by Open MPI's ``mpirun`` with more than one rank (``OMPI_COMM_WORLD_SIZE`` > 1).
+
+Under ``srun`` (Slurm) set ``YADE_MPM_MPI=1``. Every rank runs the same script and builds the same scene;
+the first step keeps each rank's slab of particles (pkg-mpm/Decomposition.hpp).
+"""
+import os
+
+
+def wanted(environ=os.environ):
+    """True if the MPI core should be loaded (see the module docstring)."""
+    v = environ.get("YADE_MPM_MPI")
+    if v is not None and v.strip() != "":
+        if v.strip() not in ("0", "1"):
+            raise ValueError(f"YADE_MPM_MPI = {v!r} must be '0' (serial core) or '1' (MPI core)")
+        return v.strip() == "1"
+    try:
+        return int(environ.get("OMPI_COMM_WORLD_SIZE", "1")) > 1
+    except ValueError:
+        return False
+
+
+def load_core(package):
+    """The compiled core module for this process: yade_mpm._core, or yade_mpm._core_mpi registered under
+    the name yade_mpm._core (so every ``from ._core import …`` of the package gets it)."""
+    import importlib
+    import sys
+    if not wanted():
+        return importlib.import_module(package + "._core")
+    try:
+        core = importlib.import_module(package + "._core_mpi")
+    except ImportError as e:
+        raise ImportError("yade_mpm: the MPI core _core_mpi was requested (mpirun with > 1 rank or YADE_MPM_MPI=1) but is not "
+                          "built: install libopenmpi-dev and rebuild (./setup.sh), or set YADE_MPM_MPI=0") from e
+    sys.modules[package + "._core"] = core
+    return core
+
+
+def rank():
+    """This process's MPI rank (0 with the serial core)."""
+    from . import _core
+    return _core.mpiRank() if hasattr(_core, "mpiRank") else 0
+
+
+def size():
+    """Number of MPI ranks (1 with the serial core)."""
+    from . import _core
+    return _core.mpiSize() if hasattr(_core, "mpiSize") else 1
