@@ -3,7 +3,7 @@
 # module, and makes `import yade` and `import yade_mpm` work for /usr/bin/python3 and for `yade`.
 set -euo pipefail
 cd "$(dirname "$0")"
-PKGS="yade libeigen3-dev libboost-python-dev libboost-numpy-dev python3-numpy python3-scipy python3-pytest python3-matplotlib python3-distributed cmake g++ make"
+PKGS="yade libeigen3-dev libboost-python-dev libboost-numpy-dev python3-numpy python3-scipy python3-pytest python3-matplotlib python3-distributed cmake g++ make libopenmpi-dev openmpi-bin"
 missing=""
 for p in $PKGS; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

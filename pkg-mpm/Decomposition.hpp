@@ -24,6 +24,7 @@ public:
 	size_t          migrated   = 0; // particles sent by this rank since the split
 
 	bool distributed() const { return R > 1; }
+	bool needsSplit() const { return R > 1 && !decomposed; } // the first step on > 1 rank always sorts (and splits)
 
 	// Refuses, before any work, what this build does not distribute yet (the same answer on every rank).
 	void checkStep(bool contactActive, size_t liveViews) const
@@ -36,6 +37,13 @@ public:
 			                 "arrays change length: delete the views before stepping (del v) and take new ones after");
 	}
 
+	// What needs the whole scene on every rank is refused once the ranks hold their own particles.
+	void refuseAfterSplit(const char* what) const
+	{
+		if (decomposed)
+			throw InputError(std::string("MPI: ") + what + " after the first step is not supported on " + std::to_string(R)
+			                 + " ranks: each rank holds only its slab's particles now (doc/scaling.md)");
+	}
 	// Before the counting sort: the first call splits the (replicated) scene, later calls migrate.
 	void migrate(const Grid<D>& g, Particles<D>& P)
 	{

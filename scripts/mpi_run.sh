@@ -17,4 +17,6 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMP_NUM_THREADS=$T
 export PYTHONPATH="$here/py${PYTHONPATH:+:$PYTHONPATH}"
-exec mpirun -np "$N" --oversubscribe --bind-to none -x OMP_NUM_THREADS -x PYTHONPATH -x YADE_MPM_MPI /usr/bin/python3 "$@"
+pass=(-x OMP_NUM_THREADS -x PYTHONPATH)
+[ -n "${YADE_MPM_MPI:-}" ] && pass+=(-x YADE_MPM_MPI)
+exec mpirun -np "$N" --oversubscribe --bind-to none "${pass[@]}" /usr/bin/python3 "$@"

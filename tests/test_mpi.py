@@ -57,6 +57,7 @@ info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "migrate
 res["rank"], res["size"], res["migrated"] = info["rank"], info["size"], info["migrated"]
 res["first"] = np.array(info["firstLayers"])
 res["y0"] = y0
+res["vtk"] = ym.output.VtuSeries(out + "_vtk").write(s)   # under MPI: a piece per rank and a .pvtu
 np.savez(f"{out}.{info['rank']}.npz", **res)
 """
 
@@ -134,7 +135,22 @@ def test_two_ranks_match_one(tmp_path, dim):
     rel = _max_rel(one, two)
     print(f"{dim}D: {len(one['x0'])} particles, {migrated} migrations, max relative difference 1 vs 2 ranks = {rel:.3e}")
     assert rel <= 1e-12, rel
+    _check_pvtu(parts, len(one["x0"]))
     assert float(parts[0]["time"][0]) == pytest.approx(float(ref[0]["time"][0]), rel=1e-12)   # the same Δt sequence
+
+
+def _check_pvtu(parts, n_total):
+    """The .pvtu of the 2-rank run lists one piece per rank; the pieces hold every particle once."""
+    import re
+    path = str(parts[0]["vtk"])
+    assert path.endswith(".pvtu") and all(str(p["vtk"]) == path for p in parts)
+    text = open(path).read()
+    pieces = re.findall(r'<Piece Source="([^"]+)"', text)
+    assert len(pieces) == len(parts), pieces
+    counts = [int(re.search(r'NumberOfPoints="(\d+)"', open(os.path.join(os.path.dirname(path), p)).read()).group(1)) for p in pieces]
+    assert counts == [len(p["id"]) for p in parts] and sum(counts) == n_total, (counts, n_total)
+    pvd = open(os.path.join(os.path.dirname(path), "particles.pvd")).read()
+    assert os.path.basename(path) in pvd
 
 
 def test_two_ranks_deterministic(tmp_path):
@@ -142,3 +158,47 @@ def test_two_ranks_deterministic(tmp_path):
     b = _merge(_run(tmp_path, "b", 2, 200, 2), FIELDS2)
     differing = [n for n in a if a[n].tobytes() != b[n].tobytes()]
     assert not differing, differing
+
+
+REFUSALS = r"""
+import sys
+import numpy as np
+import yade_mpm as ym
+rank = ym.parallel.rank()
+mat = ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0)
+def expect(what, fn, text):
+    try:
+        fn()
+    except ValueError as e:
+        assert text in str(e), (what, str(e))
+        print(f"rank {rank} refused {what}: {e}", flush=True)
+        return
+    raise AssertionError(f"{what} was not refused")
+# one block layer (8 cells) along y: 2 ranks cannot share it
+s1 = ym.make_solver((0.0, 0.0), (0.1, 0.04), 0.01, margin=2)
+ym.add_region(s1, mat, (0.0, 0.0), (0.1, 0.04))
+expect("2 ranks on 1 block layer", lambda: s1.run(1), "MPI ranks = 2 must be in [1, 1]")
+s = ym.make_solver((0.0, 0.0), (0.1, 0.3), 0.01, margin=2)
+ym.add_region(s, mat, (0.0, 0.0), (0.1, 0.3))
+v = s.view("v1")
+expect("stepping with a live view", lambda: s.run(1), "view(s) of the particle arrays are alive")
+del v
+s.run(3)
+expect("addParticles after the split", lambda: s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.2])), "after the first step")
+expect("checkpoint saving", lambda: ym.checkpoint.save("/nonexistent/ck", s), "not supported yet")
+if rank == 1:   # a bad value on one rank only: every rank stops with a ValueError (none waits forever)
+    v = s.view("v0"); v[0] = np.nan; del v
+s.requestSort()
+expect("a NaN velocity on rank 1", lambda: s.run(1), "velocity of particle id" if rank == 1 else "failed on another rank")
+print(f"rank {rank} OK", flush=True)
+"""
+
+
+def test_refusals_under_mpi(tmp_path):
+    """Unsupported or bad input under 2 ranks: a ValueError on every rank with a clear message, no hang."""
+    script = tmp_path / "refusals.py"
+    script.write_text(REFUSALS)
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
+    r = subprocess.run([LAUNCH, "2", "1", str(script)], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, (r.stdout[-3000:], r.stderr[-3000:])
+    assert "rank 0 OK" in r.stdout and "rank 1 OK" in r.stdout, r.stdout

@@ -15,6 +15,42 @@ def _b64(arr):
     return base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode("ascii")
 
 
+def _layout(a):
+    """VTK type name and component count of a point-data array (as write_vtu writes it)."""
+    a = np.asarray(a)
+    return ("Int64" if a.dtype.kind in "iu" else "Float64"), (1 if a.ndim == 1 else a.shape[1])
+
+
+def write_pvtu(path, pieces, point_data):
+    """Parallel VTU index (ParaView): the piece files (one .vtu per MPI rank, written by write_vtu) and
+    the layout of their point arrays (`point_data`: one rank's dict; every piece has the same arrays)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    with open(path, "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+                'header_type="UInt64">\n<PUnstructuredGrid GhostLevel="0">\n<PPointData>\n')
+        for name, a in point_data.items():
+            typ, nc = _layout(a)
+            f.write(f'<PDataArray type="{typ}" Name="{name}" NumberOfComponents="{nc}"/>\n')
+        f.write('</PPointData>\n<PPoints>\n<PDataArray type="Float64" NumberOfComponents="3"/>\n</PPoints>\n')
+        for p in pieces:
+            f.write(f'<Piece Source="{os.path.relpath(os.path.abspath(p), folder)}"/>\n')
+        f.write('</PUnstructuredGrid>\n</VTKFile>\n')
+
+
+def write_particle_file(stem, points, data):
+    """STEM.vtu, or under MPI (N > 1 ranks) this rank's piece STEM.rK.vtu and, from rank 0, the index
+    STEM.pvtu of all N pieces (doc/scaling.md). Returns the path to open (.vtu or .pvtu)."""
+    from .parallel import rank, size
+    if size() == 1:
+        write_vtu(stem + ".vtu", points, data)
+        return stem + ".vtu"
+    write_vtu(f"{stem}.r{rank()}.vtu", points, data)
+    if rank() == 0:
+        write_pvtu(stem + ".pvtu", [f"{stem}.r{k}.vtu" for k in range(size())], data)
+    return stem + ".pvtu"
+
+
 def write_vtu(path, points, point_data):
     """Unstructured grid of vertices with per-point arrays (1-D: scalar, 2-D: components).
     points: (N, 2|3) [m]. Binary (base64) inline data, UInt64 headers; ParaView reads it directly."""
@@ -28,10 +64,8 @@ def write_vtu(path, points, point_data):
                 'header_type="UInt64">\n<UnstructuredGrid>\n')
         f.write(f'<Piece NumberOfPoints="{n}" NumberOfCells="{n}">\n<PointData>\n')
         for name, a in point_data.items():
-            a = np.asarray(a)
-            typ = "Int64" if a.dtype.kind in "iu" else "Float64"
-            a = a.astype(np.int64 if typ == "Int64" else np.float64)
-            nc = 1 if a.ndim == 1 else a.shape[1]
+            typ, nc = _layout(a)
+            a = np.asarray(a).astype(np.int64 if typ == "Int64" else np.float64)
             f.write(f'<DataArray type="{typ}" Name="{name}" NumberOfComponents="{nc}" format="binary">{_b64(a)}</DataArray>\n')
         f.write('</PointData>\n<Points>\n')
         f.write(f'<DataArray type="Float64" NumberOfComponents="3" format="binary">{_b64(points)}</DataArray>\n')
@@ -76,9 +110,10 @@ def particle_fields(solver, x0=None):
 
 
 def write_particles(path, solver):
-    """All particle fields of a solver to a .vtu file."""
+    """All particle fields of a solver to a .vtu file (under MPI: this rank's piece and a .pvtu index with the
+    same stem, write_particle_file). Returns the path written (.vtu or .pvtu)."""
     pos, fields = particle_fields(solver)
-    write_vtu(path, pos, fields)
+    return write_particle_file(os.path.splitext(path)[0] if path.endswith(".vtu") else path, pos, fields)
 
 
 def write_csv(path, header, rows):
@@ -138,7 +173,7 @@ def read_pvd(path):
 
 class VtuSeries:
     """A VTU time series of the particles with a .pvd index for ParaView: ``write(solver)`` writes
-    DIR/NAME_NNNNNNNN.vtu (the solver step) and rewrites DIR/NAME.pvd, so the index always lists
+    DIR/NAME_NNNNNNNN.vtu (the solver step; under MPI one piece per rank and a .pvtu) and rewrites DIR/NAME.pvd, so the index always lists
     every file written so far (also after an interrupted run). Use as a runner callback:
     ``runner.run(s, ..., every=[(1e-3, series.write)])``. `fields`: a function solver → (points,
     {name: array}) (default: ``particle_fields``, every particle field)."""
@@ -156,11 +191,12 @@ class VtuSeries:
     def write(self, solver):
         """Write the current state; returns the .vtu path. A second write at the same step replaces
         the first (same file, one index entry)."""
-        path = os.path.join(self.directory, f"{self.name}_{int(solver.steps):08d}.vtu")
+        from .parallel import rank
         points, data = self.fields(solver)
-        write_vtu(path, points, data)
+        path = write_particle_file(os.path.join(self.directory, f"{self.name}_{int(solver.steps):08d}"), points, data)
         self.entries = [e for e in self.entries if e[1] != path] + [(float(solver.time), path)]
-        write_pvd(self.pvd, self.entries)
+        if rank() == 0:   # under MPI one index (.pvd of the .pvtu files) for all ranks
+            write_pvd(self.pvd, self.entries)
         return path
 
 
