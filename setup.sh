@@ -20,6 +20,11 @@ echo "$(pwd)/py" > "$site/yade_mpm.pth"
 exec 9>/tmp/yade-mpm-build.lock
 flock 9   # several checkouts/processes may build at once
 cmake -S . -B build -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build -j2 2>&1 | grep -E "error|warning" || true
-test -f py/yade_mpm/_core*.so || { echo "[setup] build failed"; exit 1; }
+# The build's own exit status decides; its errors and warnings are shown, the rest is in build/setup.log.
+if ! cmake --build build -j2 > build/setup.log 2>&1; then
+	grep -E "error|Error" build/setup.log | head -40
+	echo "[setup] build failed (full log: build/setup.log)"; exit 1
+fi
+grep -E "warning" build/setup.log || true
+test -f py/yade_mpm/_core.so || { echo "[setup] build failed: py/yade_mpm/_core.so missing"; exit 1; }
 echo "[setup] ready: $(cd / && /usr/bin/python3 -c 'import yade, yade_mpm; print("yade", yade.__file__, "| yade_mpm", yade_mpm.__file__)' 2>&1 | tail -1)"
