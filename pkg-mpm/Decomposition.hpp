@@ -27,11 +27,9 @@ public:
 	bool needsSplit() const { return R > 1 && !decomposed; } // the first step on > 1 rank always sorts (and splits)
 
 	// Refuses, before any work, what this build does not distribute yet (the same answer on every rank).
-	void checkStep(bool contactActive, size_t liveViews) const
+	void checkStep(size_t liveViews) const
 	{
 		if (!distributed()) return;
-		if (contactActive)
-			throw InputError("MPI: rigid bodies (contact) are not distributed yet (issue 22, doc/scaling.md); run scenes with bodies on 1 rank");
 		if (liveViews)
 			throw InputError("MPI: " + std::to_string(liveViews) + " NumPy view(s) of the particle arrays are alive; particles migrate between ranks and the "
 			                 "arrays change length: delete the views before stepping (del v) and take new ones after");
@@ -110,6 +108,14 @@ public:
 		if (distributed()) Comm::sum(&v, 1);
 		return v;
 	}
+	// Sums over nodes (body reactions, PtsContact): node i is counted by one rank, the owner of the block layer
+	// of the cells above it (the nodes [ownedLo, ownedHi) of the slab; the ghost layers go to the end ranks).
+	bool ownsNode(size_t i) const { return !decomposed || (i >= ownedLo && i < ownedHi); }
+	// v ← the sum of every rank's v in rank order (the same bits on every rank); called by one thread.
+	void sumInRankOrder(double* v, int n)
+	{
+		if (distributed()) Comm::sumInRankOrder(v, n, gathered);
+	}
 
 private:
 	// First step: the same particles on every rank (checked: count and a position checksum); slabs from
@@ -131,8 +137,18 @@ private:
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
 		keep(P, go);
+		settle(g);
+	}
+	void settle(const Grid<D>& g)
+	{
+		const int    ax = D - 1, B = SlabLayout<D>::B, gh = Grid<D>::ghost;
+		const size_t st = g.stride[ax];
+		ownedLo = rank == 0 ? 0 : size_t(layout.first[size_t(rank)] * B + gh) * st;
+		ownedHi = rank + 1 == R ? g.size() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
 		decomposed = true;
 	}
+	size_t              ownedLo = 0, ownedHi = 0; // nodes counted by this rank in sums over nodes (ownsNode)
+	std::vector<double> gathered;                 // scratch of sumInRankOrder
 	static size_t fieldCount(Particles<D>& P)
 	{
 		size_t n = 2; // id, material

@@ -23,8 +23,8 @@ struct GridBoxes {
 		}
 		return true;
 	}
-	// Block coordinates whose particles may lie within [lo, hi]; false when none holds particles.
-	static bool blockRange(const Grid<D>& grid, const BlockSchedule<D>& s, const Vec& lo, const Vec& hi, IVec& blo, IVec& bhi)
+	// Block coordinates whose particles may lie within [lo, hi]; false when the box misses the grid.
+	static bool blockBox(const Grid<D>& grid, const BlockSchedule<D>& s, const Vec& lo, const Vec& hi, IVec& blo, IVec& bhi)
 	{
 		constexpr int B = BlockSchedule<D>::B, M = BlockSchedule<D>::margin;
 		for (int a = 0; a < D; ++a) {
@@ -33,6 +33,12 @@ struct GridBoxes {
 			if (!(fl <= fh)) return false;
 			blo[a] = std::min(int(fl) / B, s.nBlocks[a] - 1), bhi[a] = std::min(int(fh) / B, s.nBlocks[a] - 1);
 		}
+		return true;
+	}
+	// The same; false also when none of these blocks holds particles.
+	static bool blockRange(const Grid<D>& grid, const BlockSchedule<D>& s, const Vec& lo, const Vec& hi, IVec& blo, IVec& bhi)
+	{
+		if (!blockBox(grid, s, lo, hi, blo, bhi)) return false;
 		bool any = false;
 		IVec bl = blo, bh = bhi;
 		forBox(bl, bh, [&](const IVec& c) {

@@ -12,8 +12,14 @@
 #ifdef MPM_MPI
 #include <mpi.h>
 #define MPM_IF_MPI(...) __VA_ARGS__
+// A block run by one thread of a parallel region that may call MPI: the master thread (FUNNELED) and a
+// barrier after it (MPM_ONE_THREAD_END); the serial build keeps `omp single` (its implicit barrier).
+#define MPM_ONE_THREAD _Pragma("omp master")
+#define MPM_ONE_THREAD_END _Pragma("omp barrier")
 #else
 #define MPM_IF_MPI(...)
+#define MPM_ONE_THREAD _Pragma("omp single")
+#define MPM_ONE_THREAD_END
 #endif
 
 namespace mpm {
@@ -36,6 +42,19 @@ struct Comm {
 	static void max(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, world()); }
 	static void min(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MIN, world()); }
 	static void sum(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, world()); }
+	// v ← Σ_r v_r summed in rank order 0, 1, …, R − 1 on every rank (an all-gather, then the same additions
+	// everywhere): the same bits on every rank for any rank count (MPI_SUM leaves the order to the library).
+	static void sumInRankOrder(double* v, int n, std::vector<double>& all) // all: scratch
+	{
+		const int R = size();
+		all.resize(size_t(R) * size_t(n));
+		MPI_Allgather(v, n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, world());
+		for (int k = 0; k < n; ++k) {
+			double s = all[size_t(k)];
+			for (int r = 1; r < R; ++r) s += all[size_t(r) * size_t(n) + size_t(k)];
+			v[k] = s;
+		}
+	}
 	// True on every rank iff `ok` is true on every rank (a failure on one rank stops all of them together).
 	static bool all(bool ok)
 	{

@@ -54,9 +54,14 @@
 // order); the node pass is independent per node (one thread in node order for a group with a free part,
 // after its sums); the reaction is summed by one thread in node order.
 // Results are bitwise identical for any thread count. A solver without groups never calls any of it.
+// MPI (doc/scaling.md, "Rigid bodies"): every rank holds the same bodies (YADE replicated); the particle
+// pass's node sums (f_nor, N_i, A_i) of the shared bands are exchanged like P2G's, the node pass runs on each
+// rank's copy, and the sums over nodes (the reactions, A and b of bodyResponse) count each node on its owner
+// rank only and are added over the ranks in rank order: every rank gets the same reaction bits.
 #pragma once
 #include "BlockSchedule.hpp"
 #include "ContactGroups.hpp"
+#include "ContactMpi.hpp"
 #include "GridBoxes.hpp"
 #include "WlsShape.hpp"
 
@@ -92,12 +97,14 @@ public:
 	using ContactGroups<D>::edgeOf;
 	using GridBoxes<D>::nodeRange;
 	using GridBoxes<D>::blockRange;
+	using GridBoxes<D>::blockBox;
 	using GridBoxes<D>::forNodes;
 	using GridBoxes<D>::boxCount;
 	using GridBoxes<D>::boxNode;
 
 	ContactNodes<D>     nodeArr; // per-node contact arrays (sized to the grid by the first step with bodies)
 	std::vector<size_t> marked; // nodes carrying the contact exclusion bit
+	MPM_IF_MPI(Decomposition<D>* dd = nullptr;) // MPI build: the solver's decomposition (set by the Solver)
 
 	// ---------------------------------------------------------------- before P2G (serial)
 	// World geometry, reaction reset, covered nodes excluded, per-group node/block ranges.
@@ -140,9 +147,10 @@ public:
 				});
 			// particles that may touch, and the nodes their stencils reach
 			g.bounds(reach, band, lo, hi);
-			wk.skip = !blockRange(grid, sched, lo, hi, wk.blo, wk.bhi);
+			bool near = blockRange(grid, sched, lo, hi, wk.blo, wk.bhi); // particles near the body
+			MPM_IF_MPI(if (dd && dd->distributed()) near = blockBox(grid, sched, lo, hi, wk.blo, wk.bhi);) // MPI: from the geometry
 			Vec slo = lo - Vec::Constant(2 * l), shi = hi + Vec::Constant(2 * l);
-			wk.skip = wk.skip || !nodeRange(grid, slo, shi, wk.nlo, wk.nhi);
+			wk.skip = !near || !nodeRange(grid, slo, shi, wk.nlo, wk.nhi);
 			wk.reach = reach;
 		}
 	}
@@ -220,6 +228,7 @@ public:
 					}
 				}
 			}
+			MPM_IF_MPI(contactMpi::sumShared(dd, grid, A.fn, A.load, A.area, err);) // + the neighbour ranks' partial sums
 			// symmetry planes: a node next to a plane also carries the contact of the particles' images
 			if (grid.hasMirrors()) {
 #pragma omp single
@@ -250,11 +259,12 @@ public:
 #pragma omp for schedule(static)
 				for (size_t j = 0; j < nn; ++j) stickSlip(j, nullptr);
 			} else {
-#pragma omp single
+				MPM_ONE_THREAD // (MPI: master, bodyResponse reduces over the ranks)
 				{
 					bodyResponse(grid, g, wk, dt, massFloor);
 					for (size_t j = 0; j < nn; ++j) stickSlip(j, dq.data());
 				}
+				MPM_ONE_THREAD_END
 			}
 			// 3. reaction on the parts: minus the nodal contact forces, in node order
 #pragma omp single
@@ -264,7 +274,7 @@ public:
 					Vec          f;
 					for (int a = 0; a < D; ++a) f[a] = A.force[a][i];
 					if (grid.hasMirrors()) f *= grid.mirrorShare(i); // images beyond symmetry planes are not the body's
-					if (f.isZero(0)) continue;
+					if (f.isZero(0) || !counted(i)) continue;
 					const Vec xi = grid.position(i);
 					auto&     q  = parts[onePart ? g.parts[0] : g.query(xi).part];
 					q.force -= f;
@@ -272,6 +282,11 @@ public:
 				}
 			}
 		}
+#ifdef MPM_MPI
+#pragma omp master
+		contactMpi::reduceParts(dd, flags, parts); // every rank's reactions, in rank order
+#pragma omp barrier
+#endif
 	}
 
 private:
@@ -292,6 +307,13 @@ private:
 		Vec       at(const Vec& r) const { return v + crossSpin<D>(w, r); }
 	};
 	std::vector<Motion> dq; // per part, set by bodyResponse
+	// Sums over nodes count node i on one rank only (MPI: its owner; Decomposition::ownsNode).
+	bool counted(size_t i) const
+	{
+		(void)i;
+		MPM_IF_MPI(if (dd && !dd->ownsNode(i)) return false;)
+		return true;
+	}
 	static Vec tangential(const Vec& u, const Vec& n) { return u - u.dot(n) * n; }
 	// J_jᵀ u = (u, r × u): the generalised force of a force u at r on (v, ω).
 	static QVec jT(const Vec& r, const Vec& u)
@@ -340,8 +362,9 @@ private:
 		for (int pass = 0; pass < 2; ++pass) {
 			for (int p : g.parts) Aq[p].setZero(), bq[p].setZero();
 			for (size_t j = 0; j < nn; ++j) {
-				ContactNode c;
-				if (!contactNode(grid, g, boxNode(grid, wk.nlo, wk.nhi, j), dt, massFloor, c)) continue;
+				ContactNode  c;
+				const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+				if (!counted(i) || !contactNode(grid, g, i, dt, massFloor, c)) continue;
 				if (pass == 1) { // slipping against the all-stick Δq: a known force at the limit
 					const Vec  ft = (-c.m / dt) * (c.vt - tangential(dq[c.part].at(c.r), c.n));
 					const Real fs = ft.norm();
@@ -360,6 +383,10 @@ private:
 				}
 				Aq[c.part] += m * JtJ;
 			}
+#ifdef MPM_MPI
+			for (int p : g.parts) // the sums over every rank's nodes (A, b: fixed-size Eigen, contiguous)
+				dd->sumInRankOrder(Aq[p].data(), NQ * NQ), dd->sumInRankOrder(bq[p].data(), NQ);
+#endif
 			for (int p : g.parts) {
 				const auto& q = parts[p];
 				dq[p]         = Motion {};
@@ -375,6 +402,7 @@ private:
 	}
 	std::vector<QMat> Aq; // per part: A of bodyResponse
 	std::vector<QVec> bq; // per part: b (+ c) of bodyResponse
+	MPM_IF_MPI(std::vector<double> flags;) // MPI scratch of reduceParts
 
 	void ensureArrays(const Grid<D>& grid)
 	{

@@ -40,7 +40,11 @@ public:
 	void   viewOpened() { ++liveViews, viewTaken = true; }
 	void   viewClosed() { --liveViews; }
 
-	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched) { materials.setCell(grid.spacing); }
+	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched)
+	{
+		materials.setCell(grid.spacing);
+		MPM_IF_MPI(contact.dd = &dd;) // MPI: the contact sums its shared nodes and reduces the body reactions
+	}
 	Solver(const Solver&)            = delete; // xfer refers to the members
 	Solver& operator=(const Solver&) = delete;
 
@@ -139,7 +143,7 @@ public:
 		if (dt > lim * (1 + 1e-12))
 			throw InputError("dt = " + fmtNum(dt) + " s exceeds the stable time step " + fmtNum(lim) + " s (Δt ≤ C·l/(v_c + max‖v‖), C = "
 			                 + fmtNum(courant) + "); lower dt or switch autoDt on");
-		MPM_IF_MPI(dd.checkStep(contact.active(), liveViews);)
+		MPM_IF_MPI(dd.checkStep(liveViews);)
 		double t0 = omp_get_wtime();
 		if (needSort || (steps % sortPeriod) == 0 MPM_IF_MPI(|| dd.needsSplit())) {
 			MPM_IF_MPI(dd.migrate(grid, P);) // particles that left the rank's slab go to its neighbour
@@ -179,9 +183,9 @@ public:
 	Real   cohesion(size_t p) const { return materials.cohesion(P, p); }               // Eq. 34; NaN if not DP–GK
 	bool   materialVelocity(size_t p, Real (&v)[D]) const { return xfer.materialVelocity(p, v); } // at x_p (Transfer.hpp)
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
-	Real maxSpeed() // max ‖v‖ [m/s], refreshed after requestSort()
+	Real maxSpeed() // max ‖v‖ [m/s], refreshed after requestSort(); MPI: a collective (every rank calls it)
 	{
-		if (needCheck && P.n && materials.size()) prepare();
+		if (needCheck && (P.n MPM_IF_MPI(|| dd.decomposed)) && materials.size()) prepare(); // a rank without particles joins
 		return vmax;
 	}
 	const BlockSchedule<D>& schedule() const { return sched; }

@@ -59,7 +59,11 @@ struct ContactWrap {
 	static ContactParams contactParams(S& s, int g) { return s.contact.group(g).params; }
 	static int           numContactGroups(S& s) { return int(s.contact.groups.size()); }
 	// d0 = 'initial': capture d0_p = d_p(0) of the first particle layer at the group's current pose (registration).
-	static void captureContactD0(S& s, int g) { s.contact.captureInitialD0(g, s.P); }
+	static void captureContactD0(S& s, int g)
+	{
+		MPM_IF_MPI(s.dd.refuseAfterSplit("d0 = 'initial' (registering a body)");) // the capture needs every particle
+		s.contact.captureInitialD0(g, s.P);
+	}
 	static void removeLastContactGroup(S& s) { s.contact.removeLastGroup(); }
 	// Captured d0 [m] per stable particle id (NaN: the default half edge); empty unless d0 = 'initial'.
 	static np::ndarray contactInitialD0(S& s, int g)

@@ -15,6 +15,9 @@ if [[ "$1" =~ ^[0-9]+$ ]]; then T=$1; shift; fi
 [[ "$T" =~ ^[1-9][0-9]*$ ]] || { echo "THREADS = '$T' must be an integer ≥ 1" >&2; exit 2; }
 here=$(cd "$(dirname "$0")/.." && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# A rank waiting in MPI yields its core (shared or loaded hosts: busy polling slowed the 2-rank tunnel
+# 3.9×, doc/scaling.md); OMPI_MCA_mpi_yield_when_idle=0 restores Open MPI's polling on dedicated cores.
+export OMPI_MCA_mpi_yield_when_idle=${OMPI_MCA_mpi_yield_when_idle:-1}
 export OMP_NUM_THREADS=$T
 export PYTHONPATH="$here/py${PYTHONPATH:+:$PYTHONPATH}"
 pass=(-x OMP_NUM_THREADS -x PYTHONPATH)

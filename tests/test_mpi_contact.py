@@ -1,0 +1,100 @@
+"""Rigid YADE bodies under MPI (pkg-mpm/ContactMpi.hpp, doc/scaling.md "Rigid bodies"): every rank runs the
+same YADE scene; the contact of each rank's nodes is reduced over the ranks in rank order before YADE
+integrates the bodies. A 2D elastic block falling at 5 m/s (particles cross the slab boundary) is pushed by a rigid top platen (only the upper rank touches it) and a right platen (both ranks),
+and holds a free rigid filler in a vertical slot across the slab boundary (its stick step, bodyResponse,
+sums nodes of both ranks). On 2 ranks against 1 process (serial core), 150 steps: the particle fields by id,
+the three bodies' impulses (Σ reaction · Δt) and the filler's motion agree within 1e-10 relative (roundoff: the sums are
+added in another order), and both ranks' YADE scenes hold the same bits."""
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from test_mpi import LAUNCH, ROOT, _max_rel, _merge, _mpi_available
+
+pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+pytest.importorskip("yade")
+
+CHILD = r"""
+import math, sys
+import numpy as np
+import yade_mpm as ym
+from yade import O, utils
+from yade_mpm import cases
+from yade_mpm.bodies import RigidBodies
+from yade_mpm.cases.loading import yade_engines, yade_filler, yade_platen
+steps, out = int(sys.argv[1]), sys.argv[2]
+l, W, H = 0.01, 0.2, 0.32                      # 36 cells along y with the margins: 2 ranks split at y = 0.14
+slot = cases.tunnel.tunnel_flaw(toe=(0.1, 0.06), length=0.2, width=0.02, angle=math.pi / 2)   # x 0.09–0.11, y 0.06–0.26
+s = ym.make_solver((0.0, 0.0), (W, H), l, margin=2)
+ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0.0), (W, H), holes=[slot["polygon"]])
+s.addBoundaryPlane(0, -1, 0.0, "slip")          # a symmetry plane normal to x; no floor: the block falls freely
+O.reset()
+rb = RigidBodies(s)
+top = yade_platen(rb, W / 2, H, W, l, 6.0, 0.3)                 # down at 6 m/s, μ = 0.3
+hp = 5 * l                                                       # right platen: left at 0.5 m/s, μ = 0.2, full height
+right = O.bodies.append(utils.box((W + hp, H / 2, 0), (hp, 0.6 * H, 0.5), fixed=False))
+O.bodies[right].state.blockedDOFs = "xyzXYZ"
+O.bodies[right].state.vel = (-0.5, 0, 0)
+rb.add(right, mu=0.2)
+filler = yade_filler(rb, slot, 0.6, density=2000.0)            # free in the plane, d0 = "initial"
+eng = yade_engines(s, rb, "mpm")
+v = s.view("v1"); v[:] = -5.0; del v                             # falling: particles cross y = 0.14
+s.requestSort()
+react = lambda: np.array([list(rb.force(b)) + list(np.atleast_1d(rb.torque(b))) for b in (top, right, filler)])
+res = {"impulse": 0.0}
+for _ in range(steps):                                           # Σ reactions over the steps (Δt is global)
+    O.step()
+    res["impulse"] = res["impulse"] + react() * O.dt
+names = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol", "id"]
+res.update({n: np.array(s.view(n)) for n in names})
+info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "migrated": 0, "firstLayers": []}
+res["rank"], res["size"], res["migrated"], res["first"] = info["rank"], info["size"], info["migrated"], np.array(info["firstLayers"])
+res["forces"] = react()
+st = O.bodies[filler].state
+res["filler"] = np.array(list(st.pos) + list(st.vel) + list(st.angVel) + [st.ori[k] for k in range(4)])
+res["time"] = np.array([s.time, O.time])
+np.savez(f"{out}.{info['rank']}.npz", **res)
+"""
+
+NAMES = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol"]
+
+
+def _run(tmp_path, tag, steps, ranks):
+    script = tmp_path / "contact_child.py"
+    script.write_text(CHILD)
+    out = str(tmp_path / tag)
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
+    env.pop("YADE_MPM_MPI", None)
+    cmd = [sys.executable, str(script), str(steps), out] if ranks == 1 else [LAUNCH, str(ranks), "1", str(script), str(steps), out]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, (r.stdout[-2000:], r.stderr[-3000:])
+    return [dict(np.load(f"{out}.{k}.npz")) for k in range(ranks)]
+
+
+def test_bodies_two_ranks_match_one(tmp_path):
+    ref = _run(tmp_path, "one", 150, 1)
+    parts = _run(tmp_path, "two", 150, 2)
+    one, two = _merge(ref, NAMES), _merge(parts, NAMES)
+    first = parts[0]["first"]
+    assert list(first) == [0, 2, 5], first   # 36 cells (2 of margin each side): split at 16 cells from y = −0.02, y = 0.14 m
+    assert sum(int(p["migrated"]) for p in parts) > 20
+    # both ranks' YADE scenes are the same bits: reactions and the free filler's state
+    for k in ("forces", "impulse", "filler", "time"):
+        assert parts[0][k].tobytes() == parts[1][k].tobytes(), (k, parts[0][k], parts[1][k])
+    f1, f2 = ref[0]["impulse"], parts[0]["impulse"]
+    # the contacts are real: the platens push (the rock pushes the top platen up, the right platen right),
+    # the filler is squeezed and moves
+    assert f1[0, 1] > 1.0 and f1[1, 0] > 1.0 and np.abs(f1[2, :2]).max() > 0.1 and np.abs(ref[0]["filler"][2:4]).max() > 1e-2, (f1, ref[0]["filler"])
+    rel_f = np.abs(f2 - f1).max(axis=1) / np.abs(f1).max(axis=1)
+    fill1, fill2 = ref[0]["filler"], parts[0]["filler"]
+    rel_fill = np.abs(fill2[2:6] - fill1[2:6]).max() / np.abs(fill1[2:6]).max()       # velocity and spin
+    rel = _max_rel(one, two)
+    print(f"bodies under MPI: fields {rel:.2e}, impulses {rel_f}, filler velocity {rel_fill:.2e}, "
+          f"filler position {np.abs(fill2[:2] - fill1[:2]).max():.2e} m")
+    assert rel <= 1e-10 and rel_f.max() <= 1e-10 and rel_fill <= 1e-10
+    assert np.abs(fill2[:3] - fill1[:3]).max() <= 1e-13
+    assert float(parts[0]["time"][0]) == pytest.approx(float(ref[0]["time"][0]), rel=1e-12)
