@@ -32,6 +32,9 @@ def parse():
     ap.add_argument("--end-time", type=float, default=None, help="loading time [s] (default: tunnel 0.02, uniaxial 0.014)")
     ap.add_argument("--mu-con", type=float, default=0.6, help="filler friction of the uniaxial filled case (default 0.6)")
     ap.add_argument("--out", default="out/fidelity_variants")
+    ap.add_argument("--baseline-from", default=None, metavar="CASE_DIR",
+                    help="write the tunnel baseline row from a finished default run of scripts/tunnel_spalling.py (its case folder, "
+                         "e.g. out/tunnel/filled_flaw: case.json, axial_stress.csv, snapshot_*ms.npz) instead of running it again")
     a = ap.parse_args()
     a.case = a.case or ("filled_flaw" if a.scene == "tunnel" else "open")
     a.spacing = a.spacing or (0.0025 if a.scene == "tunnel" else 0.002)
@@ -46,10 +49,14 @@ def parse():
 
 
 def build(a, v):
-    mat = v.get("material", {})
+    mat = dict(v.get("material", {}))
+    if v.get("eps_p_reference"):             # the reference code's ε̄p increment, as an equivalent ε̄p,crit
+        base = rocks.pan2020_sandstone() if a.scene == "tunnel" else rocks.miao2018_sandstone()
+        mat["critPlasticStrain"] = fidelity.reference_crit_strain(base)
     if a.scene == "tunnel":
         s, b = cases.arch_tunnel(a.case, a.spacing, material=rocks.pan2020_sandstone(**mat), floor=v.get("floor", cases.TUNNEL_FLOOR),
-                                 flaw_angle=math.radians(v.get("flaw_angle", cases.FLAW_ANGLE_DEG)), flaw_toe_gap=v.get("flaw_toe_gap", cases.FLAW_TOE_GAP))
+                                 flaw_angle=math.radians(v.get("flaw_angle", cases.FLAW_ANGLE_DEG)), flaw_toe_gap=v.get("flaw_toe_gap", cases.FLAW_TOE_GAP),
+                                 flaw_toe_height=v.get("flaw_toe_height", cases.FLAW_TOE_HEIGHT))
         return s, b, b["platen_displacement"], b["axial_stress"]
     s, b = cases.uniaxial_flaw(a.case, a.spacing, mu_con=a.mu_con if a.case == "filled" else 0.0, material=rocks.miao2018_sandstone(**mat))
     return s, b, lambda: b["axial_strain"]() * b["height"], b["axial_stress"]
@@ -81,6 +88,8 @@ def run_one(a, name):
     def snap(solver):
         f = ym.fields(solver, ["pos", "damage", "plastic_strain", "mass"])
         rep, _ = cases.tunnel_report(f, lat, fl, soft_end, floor=b["floor"])
+        ep = np.asarray(f["plastic_strain"], float)          # how far the rock is from softening (Eq. 34 ends at soft_end)
+        rep.update(eps_p_max=float(ep.max()), eps_p_p99=float(np.percentile(ep, 99)), eps_p_soft_end=float(np.min(soft_end)))
         res["snapshots"][f"{solver.time * 1e3:.0f}ms"] = rep
 
     def softened(solver):                       # uniaxial: stop after the peak as uniaxial_flaw.py does
@@ -114,9 +123,44 @@ def run_one(a, name):
     return res
 
 
+def baseline_from(a, folder):
+    """The baseline JSON of the tunnel scene from tunnel_spalling.py's default run of the same case (same scene and
+    defaults: cases.arch_tunnel, the solver's C): its snapshot reports, first crack, curve and the ε̄p statistics."""
+    if a.scene != "tunnel":
+        raise SystemExit("--baseline-from: only for --scene tunnel (a tunnel_spalling.py case folder)")
+    cj = json.load(open(os.path.join(folder, "case.json")))
+    if not cj.get("finished"):
+        raise SystemExit(f"--baseline-from {folder}: the run is not finished (case.json: finished = false)")
+    summ = json.load(open(os.path.join(os.path.dirname(os.path.normpath(folder)), "summary.json")))
+    entry = next(e for e in summ["cases"] if e["case"] == a.case)
+    soft_end = (1 - rocks.pan2020_sandstone().residualCohesion) * rocks.pan2020_sandstone().critPlasticStrain
+    snaps = {}
+    for key, rep in cj["snapshots"].items():
+        with np.load(os.path.join(folder, f"snapshot_{key}.npz")) as z:
+            ep = np.asarray(z["plastic_strain"], float)
+        snaps[f"{float(key[:-2]):.0f}ms"] = dict(rep, eps_p_max=float(ep.max()), eps_p_p99=float(np.percentile(ep, 99)), eps_p_soft_end=soft_end)
+    c = np.loadtxt(os.path.join(folder, "axial_stress.csv"), delimiter=",", skiprows=1, ndmin=2)    # time_s, displacement_mm, MPa
+    fc = cj.get("first_crack")
+    res = dict(scene="tunnel", case=a.case, variant="baseline", label=fidelity.VARIANTS["baseline"]["label"] + f" — the default run `{folder}`",
+               spacing_m=entry["grid_spacing_m"], end_time_s=float(c[-1, 0]), particles=entry["particles"], snapshots=snaps,
+               first_crack=fc and dict(time_s=fc["time"], at=fc["location"]), wall_time_s=entry["wall_time_s"], steps=entry["steps"],
+               curve_shape=fidelity.curve_shape(c[:, 1], c[:, 2]),
+               stress_MPa_at_mm={f"{m:g}": float(np.interp(m, c[:, 1], c[:, 2])) for m in (0.25, 0.5, 1.0, 1.5, 2.0) if m <= c[-1, 1] + 1e-9})
+    res["build"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                  cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
+    return res
+
+
 def main():
     a = parse()
     os.makedirs(a.out, exist_ok=True)
+    if a.baseline_from:
+        res = baseline_from(a, a.baseline_from)
+        path = os.path.join(a.out, f"{a.scene}_{a.case}_baseline.json")
+        with open(path, "w") as f:
+            json.dump(fidelity.json_safe(res), f, indent=1)
+        print(f"RESULT {path}: from {a.baseline_from}")
+        return
     for name in a.variants:
         res = run_one(a, name)
         path = os.path.join(a.out, f"{a.scene}_{a.case}_{name}.json")

@@ -235,6 +235,7 @@ def tunnel(R, part, title, keys_intact=("08ms", "12ms", "20ms"), keys_flaw=("20m
     R.w(f"## {title}", "")
     s = R.load(part)
     if s is None:
+        frozen(R)
         return None
     cs = s["cases"]
 
@@ -386,6 +387,15 @@ def variant_matrix(R, folder="fidelity_variants"):
                     ("bands at the end (Fig. 18b)", lambda r: ", ".join(f"{b['side'][0]} {abs(b['angle_deg']):.0f}°" for b in sn(r, last(r)).get('bands', [])[:3])),
                     ("plastic zones at the end: fill L / R, ½ = triangle (Fig. 18a)", lambda r: " / ".join(f"{sn(r, last(r)).get('plastic_zones', {}).get(k, {}).get('fill', float('nan')):.2f}" for k in ("left", "right"))),
                     ("toe link at the end (Fig. 19f)", lambda r: sn(r, last(r)).get("toe_link_to_opening")),
+                    ("failed zone from the toe ends [mm] from the opening, nearest (Fig. 19e, f)",
+                     lambda r: sn(r, last(r)).get("toe_failed_gap_mm") is not None
+                     and f"{sn(r, last(r))['toe_failed_gap_mm']:.1f}, {sn(r, last(r)).get('toe_failed_nearest')}"),
+                    ("spalled at the left wall / corner / spandrel [mm²] (Fig. 19e, g)",
+                     lambda r: " / ".join(f"{(sn(r, last(r)).get('spalled_by_place_mm2') or {}).get(k, 0):.0f}"
+                                          for k in ("left wall", "left corner", "left spandrel"))),
+                    ("ε̄p max / p99 at the end (softening ends at) (Fig. 18b)",
+                     lambda r: "eps_p_max" in sn(r, last(r)) and f"{sn(r, last(r))['eps_p_max']:.3g} / {sn(r, last(r))['eps_p_p99']:.2g} "
+                     f"({sn(r, last(r))['eps_p_soft_end']:.2g})"),
                     ("left waist in [mm] p90 (Fig. 19g)", lambda r: f"{(sn(r, last(r)).get('left_waist_inward_mm') or {}).get('p90', float('nan')):.3f}")]
         R.w("| variant | " + " | ".join(c for c, _ in cols) + " | wall [s] |", "|---|" + "---|" * (len(cols) + 1))
         for r in rs:
@@ -411,11 +421,21 @@ def courant_section(R, folder="courant"):
     R.w("## Time step: the Courant number chosen by accuracy (issue 19)", "")
     if not runs:
         R.w(f"*Not run here* — the scripts of `scripts/regress.py` with `--courant C` into `{shown(d)}/cC/` (see the notes of a run).", "")
+        frozen(R)
         return
     notes = os.path.join(d, "notes.md")
     if os.path.exists(notes):
         R.w(open(notes).read().rstrip(), "")
     R.w(fidelity_courant.markdown(fidelity_courant.collect(runs)), "")
+
+
+FROZEN = "paper_grid_and_courant_7ac11e5.md"      # the last paper-grid tunnel runs and C-study, kept verbatim (outputs not kept)
+
+
+def frozen(R):
+    """Link the frozen record of sections whose outputs are not here (doc/FROZEN)."""
+    if os.path.exists(os.path.join(REPO, "doc", FROZEN)):
+        R.w(f"The last runs of this section (main `7ac11e5`, simulation code of `d734961`) are kept verbatim in [{FROZEN}]({FROZEN}).", "")
 
 
 def _ms(t):

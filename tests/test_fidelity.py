@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from yade_mpm import analysis, cases, fidelity, fidelity_table
+from yade_mpm import analysis, cases, fidelity, fidelity_table, rocks
 
 from test_analysis import DP
 from test_analysis import lattice as _lattice
@@ -96,6 +96,11 @@ def test_tunnel_flaw_at_defaults_and_variants():
     assert math.degrees(c["angle"]) == pytest.approx(45)
     with pytest.raises(ValueError, match="flaw_toe_gap"):
         cases.tunnel_flaw_at(toe_gap=-1)
+    w = cases.tunnel_flaw_at(toe_height=0.0125)                  # the flaw_toe_waist variant: toe at mid-wall height
+    assert w["toe"] == pytest.approx([0.045, 0.055 + 0.0125]) and np.allclose(w["tip"] - w["toe"], a["tip"] - a["toe"])
+    for bad in (-1e-3, 0.026):
+        with pytest.raises(ValueError, match=r"flaw_toe_height .* must be in \[0, 0.025\]"):
+            cases.tunnel_flaw_at(toe_height=bad)
     with pytest.raises(ValueError, match="variant"):
         fidelity.variant("floor_52.5mm", "uniaxial")
 
@@ -139,3 +144,15 @@ def test_table_rows_from_constructed_summaries():
     rows = fidelity_table.rows(dict(uniaxial_flaw=u, tunnel=t))
     assert len(rows) == len(fidelity_table.ROWS)
     assert all(r["default"] for r in rows) and {r["verdict"] for r in rows if r["part"] == "circular_opening"} == {"not run"}
+
+
+def test_reference_crit_strain_matches_the_reference_codes_softening_rate():
+    # Graphyt: c = c0 (1 − ε̄p/ε_crit) with Δε̄p = k̄φ Δλ; here Δε̄p = Δλ/√3: equal dc/dΔλ needs ε' = ε_crit/(√3 k̄φ)
+    for phi_deg, expect in ((39.0, 0.0508), (38.0, 0.0504)):
+        m = rocks.pan2020_sandstone(frictionAngle=math.radians(phi_deg))
+        s, c = math.sin(m.frictionAngle), math.cos(m.frictionAngle)
+        kphi = 6 * c / (math.sqrt(3) * (3 - s))
+        e = fidelity.reference_crit_strain(m)
+        assert m.cohesion * kphi / m.critPlasticStrain == pytest.approx(m.cohesion / (math.sqrt(3) * e), rel=1e-12)
+        assert e == pytest.approx(expect, abs=2e-4)
+

@@ -110,10 +110,24 @@ VARIANTS = {
     "v_cube": dict(material=dict(thresholdVolume="cube"), label="V of Eq. 37 = dp³ (the old default, fitted to Fig. 9)"),
     "no_residual_cohesion": dict(material=dict(residualCohesion=0.0), label="residual cohesion 0 instead of 0.1 c₀"),
     "soft_strain_0.01": dict(material=dict(critPlasticStrain=0.01), label="ε̄p,crit = 0.01 instead of 0.1 (softening within reach of the grid's strains)"),
+    "eps_p_reference": dict(eps_p_reference=True,
+                            label="ε̄p grown as in the reference code (Graphyt: Δε̄p = k̄φ Δλ, not Δλ/√3): Eq. 34 then softens as "
+                                  "ε̄p,crit = 0.1/(√3 k̄φ) does here (0.051 at φ = 39°, 0.050 at 38°)"),
     "floor_52.5mm": dict(floor=0.0525, scene="tunnel", label="opening's floor at 52.5 mm (centred 45 mm-high opening) instead of 55 mm"),
     "flaw_angle_45": dict(flaw_angle=45.0, scene="tunnel", label="flaw inclined 45° instead of 60° (the paper gives no angle)"),
     "flaw_gap_5mm": dict(flaw_toe_gap=0.005, scene="tunnel", label="flaw toe 5 mm from the left wall instead of 10 mm (position not given)"),
+    "flaw_toe_waist": dict(flaw_toe_height=0.0125, scene="tunnel",
+                           label="flaw toe at mid-wall height (12.5 mm above the floor) instead of spandrel height (25 mm; not given)"),
 }
+
+
+def reference_crit_strain(material):
+    """ε̄p,crit [-] that gives this code's Eq. 34 (ε̄p grown by Δλ/√3 on the cone) the softening per unit plastic
+    multiplier of the reference code, whose ε̄p grows by k̄φ Δλ (Graphyt, ConstitutiveModels.cpp,
+    druckerPrager_Damage: acc_plastic_strain += dL·ξ, ξ = k̄φ of Eq. 31): c₀ k̄φ / ε_crit = c₀ / (√3 ε'_crit)."""
+    phi = material.frictionAngle
+    kphi = 6 * math.cos(phi) / (math.sqrt(3) * (3 - math.sin(phi)))    # Eq. 31
+    return material.critPlasticStrain / (math.sqrt(3) * kphi)
 
 
 def variant(name, scene):

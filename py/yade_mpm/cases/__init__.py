@@ -4,7 +4,7 @@ scenes here and keep only their command line, plots and narrative.
     circular_opening(spacing, ...)   paper Sec. 3.1: holed block under biaxial in-situ stress
     line_crack(size, spacing, ...)   paper Sec. 3.2: pressurised line ("penny-shaped") crack
     arch_tunnel_holes(...)           paper Sec. 4: the arch-shaped tunnel opening (geometry only)
-    tunnel_flaw(...) / tunnel_flaw_at(floor, angle, gap)   paper Sec. 4: the 60 × 2 mm flaw left of the tunnel (geometry)
+    tunnel_flaw(...) / tunnel_flaw_at(floor, angle, gap, toe_height)   paper Sec. 4: the 60 × 2 mm flaw left of the tunnel (geometry)
     arch_tunnel_specimen(spacing, ...)  the tunnel specimen with its opening and slip walls (no top load)
     arch_tunnel(case, spacing, ...)  paper Sec. 4 + grout: the full scene with the YADE platen (and filler)
     uniaxial_flaw(variant, spacing, ...)  paper Sec. 3.3: 50 × 150 mm specimen, platen, open/rigid-filled flaw
@@ -24,7 +24,8 @@ from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING
                       circular_opening, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
 from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler,
                       yade_platen)
-from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_WIDTH, TUNNEL_CASES,
+from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_TOE_HEIGHT,
+                     FLAW_WIDTH, TUNNEL_CASES,
                      TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
                      arch_tunnel, arch_tunnel_holes, arch_tunnel_specimen, tunnel_fidelity, tunnel_flaw, tunnel_flaw_at, tunnel_location,
                      tunnel_opening_distance, tunnel_report, tunnel_where)

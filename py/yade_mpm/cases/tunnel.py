@@ -63,7 +63,8 @@ FLAW_WIDTH = 0.002                 # [m]
 FLAW_ANGLE_DEG = 60.0              # inclination to the horizontal [°]; rises to the left, away from the tunnel
 FLAW_ANGLE = math.radians(FLAW_ANGLE_DEG)   # the same [rad]
 FLAW_TOE_GAP = 0.010               # horizontal rock bridge from the toe (lower end) to the left wall [m]
-FLAW_TOE = (TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - FLAW_TOE_GAP, TUNNEL_FLOOR + TUNNEL_RECT[1])  # at spandrel height [m]
+FLAW_TOE_HEIGHT = TUNNEL_RECT[1]   # toe height above the opening's floor [m]: spandrel height (top of the walls)
+FLAW_TOE = (TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - FLAW_TOE_GAP, TUNNEL_FLOOR + FLAW_TOE_HEIGHT)  # [m]
 
 # Loading and contact of Sec. 4 (platen speed and friction, filler χ: cases.loading)
 TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displacement)
@@ -93,17 +94,21 @@ def _flaw_clear(angle, spacing):
     return bool(np.all((p >= spacing) & (p <= TUNNEL_WIDTH - spacing)) and np.all(tunnel_opening_distance(p) >= spacing))
 
 
-def tunnel_flaw_at(floor=TUNNEL_FLOOR, angle=FLAW_ANGLE, toe_gap=FLAW_TOE_GAP):
+def tunnel_flaw_at(floor=TUNNEL_FLOOR, angle=FLAW_ANGLE, toe_gap=FLAW_TOE_GAP, toe_height=FLAW_TOE_HEIGHT):
     """``tunnel_flaw()`` for an opening with its floor at `floor` [m]: the toe `toe_gap` [m] left of the
-    left wall at spandrel height (floor + 25 mm), inclined `angle` [rad] (default FLAW_ANGLE)."""
+    left wall, `toe_height` [m] above the floor, in [0, 25 mm] (the wall's height; default 25 mm, spandrel
+    height), inclined `angle` [rad] (default FLAW_ANGLE)."""
     angle = _number(angle, "flaw_angle", "rad")
     toe_gap = _number(toe_gap, "flaw_toe_gap", "m", positive=True)
-    return tunnel_flaw(toe=(TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - toe_gap, floor + TUNNEL_RECT[1]), angle=angle)
+    toe_height = _number(toe_height, "flaw_toe_height", "m")
+    if not 0 <= toe_height <= TUNNEL_RECT[1]:
+        raise ValueError(f"flaw_toe_height = {toe_height!r} m must be in [0, {TUNNEL_RECT[1]}] m (beside the left wall)")
+    return tunnel_flaw(toe=(TUNNEL_WIDTH / 2 - TUNNEL_RECT[0] / 2 - toe_gap, floor + toe_height), angle=angle)
 
 
 def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
                 platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm",
-                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP):
+                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP, flaw_toe_height=FLAW_TOE_HEIGHT):
     """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
     arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
     DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
@@ -115,7 +120,8 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     spacing: grid spacing l [m] (paper 1 mm); material: the rock (default ``rocks.pan2020_sandstone()``);
     flaw_angle: the flaw's inclination [rad] about its toe (FLAW_ANGLE; it must leave a cell of rock to every face).
     floor [m]: height of the opening's floor (default TUNNEL_FLOOR = 55 mm; the paper gives none, a centred
-    opening has 52.5 mm); flaw_toe_gap [m]: the toe's distance from the left wall (``tunnel_flaw_at``; not given in the paper).
+    opening has 52.5 mm); flaw_toe_gap, flaw_toe_height [m]: the toe's distance from the left wall and height above
+    the floor (``tunnel_flaw_at``; neither is given in the paper).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
@@ -138,7 +144,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     from ..bodies import RigidBodies
 
     W = TUNNEL_WIDTH
-    flaw = tunnel_flaw_at(floor, flaw_angle, flaw_toe_gap) if case != "intact" else None
+    flaw = tunnel_flaw_at(floor, flaw_angle, flaw_toe_gap, flaw_toe_height) if case != "intact" else None
     rock = material or rocks.pan2020_sandstone()
     holes = [flaw["polygon"]] if flaw is not None else []
     s = arch_tunnel_specimen(spacing, rock, ppc, floor=floor, holes=holes)
