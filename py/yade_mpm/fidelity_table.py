@@ -197,7 +197,9 @@ def u_scatter(u):
             f"{_f(a and a['cv'])})", "agrees" if (b["cv"] or 0) >= 0.5 else "partly")
 
 
-PAPER_UNIAXIAL = "not run: the paper's 0.5 mm uniaxial grid (16× the particle-steps of 2 mm) did not fit the shared CPU"
+PAPER_UNIAXIAL = ("not run: at 0.5 mm the open-flaw scene has 119,200 particles (16× 2 mm's) and 8,460 steps per ms (4×), "
+                  "64× the particle-steps; a 0.1 ms probe ran 1.38 M particle-steps/s on one shared thread, so one run to its "
+                  "post-peak stop (≈ 75,000 steps) needs ≈ 110 min, over the session's budget")
 PAPER_BENCH = "benchmarks: the paper's grid is the convergence study's finest point where run"
 
 ROWS = [  # fig, claim, part, measure
