@@ -142,7 +142,7 @@ def baseline_from(a, folder):
     c = np.loadtxt(os.path.join(folder, "axial_stress.csv"), delimiter=",", skiprows=1, ndmin=2)    # time_s, displacement_mm, MPa
     fc = cj.get("first_crack")
     res = dict(scene="tunnel", case=a.case, variant="baseline", label=fidelity.VARIANTS["baseline"]["label"] + f" — the default run `{folder}`",
-               spacing_m=entry["grid_spacing_m"], end_time_s=float(c[-1, 0]), particles=entry["particles"], snapshots=snaps,
+               spacing_m=entry["grid_spacing_m"], end_time_s=float(f"{c[-1, 0]:.4g}"), particles=entry["particles"], snapshots=snaps,
                first_crack=fc and dict(time_s=fc["time"], at=fc["location"]), wall_time_s=entry["wall_time_s"], steps=entry["steps"],
                curve_shape=fidelity.curve_shape(c[:, 1], c[:, 2]),
                stress_MPa_at_mm={f"{m:g}": float(np.interp(m, c[:, 1], c[:, 2])) for m in (0.25, 0.5, 1.0, 1.5, 2.0) if m <= c[-1, 1] + 1e-9})

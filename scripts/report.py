@@ -363,6 +363,10 @@ def variant_matrix(R, folder="fidelity_variants"):
                 "[fidelity_variants_d734961.md](fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
         return
     runs = [json.load(open(f)) for f in files]
+    if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
+        R.w("Variants not in the matrix below (uniaxial growth law, V = dp³, residual cohesion, ε̄p,crit = 0.01, tunnel intact at "
+            "2.5 mm) were screened on an older build (before issue 17's contact fix): "
+            "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
     notes = os.path.join(R.root, folder, "notes.md")
     if os.path.exists(notes):
         R.w(open(notes).read().rstrip(), "")
@@ -389,7 +393,8 @@ def variant_matrix(R, folder="fidelity_variants"):
                     ("toe link at the end (Fig. 19f)", lambda r: sn(r, last(r)).get("toe_link_to_opening")),
                     ("failed zone from the toe ends [mm] from the opening, nearest (Fig. 19e, f)",
                      lambda r: sn(r, last(r)).get("toe_failed_gap_mm") is not None
-                     and f"{sn(r, last(r))['toe_failed_gap_mm']:.1f}, {sn(r, last(r)).get('toe_failed_nearest')}"),
+                     and ("reaches it" if sn(r, last(r)).get("toe_link_to_opening") not in (None, "nowhere") else
+                          f"{sn(r, last(r))['toe_failed_gap_mm']:.1f}, {sn(r, last(r)).get('toe_failed_nearest')}")),
                     ("spalled at the left wall / corner / spandrel [mm²] (Fig. 19e, g)",
                      lambda r: " / ".join(f"{(sn(r, last(r)).get('spalled_by_place_mm2') or {}).get(k, 0):.0f}"
                                           for k in ("left wall", "left corner", "left spandrel"))),
