@@ -42,6 +42,26 @@ public:
 			throw InputError(std::string("MPI: ") + what + " after the first step is not supported on " + std::to_string(R)
 			                 + " ranks: each rank holds only its slab's particles now (doc/scaling.md)");
 	}
+	// Checkpoint resume (py/yade_mpm/checkpoint.py) into the freshly built, replicated scene: the saved slab
+	// layout, and the particle arrays cut to the rank's saved count n (the caller then writes the saved values).
+	void restore(const Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n)
+	{
+		if (decomposed) throw InputError("MPI checkpoint resume: the solver has stepped already; load the checkpoint into the freshly built scene");
+		if (int(first.size()) != R + 1)
+			throw InputError("MPI checkpoint resume: the checkpoint's slab layout has " + std::to_string(int(first.size()) - 1) + " ranks, this run has " + std::to_string(R));
+		if (n > P.n) throw InputError("MPI checkpoint resume: " + std::to_string(n) + " particles saved on this rank, the scene has " + std::to_string(P.n));
+		SlabLayout<D> L;
+		L.first = first;
+		for (int r = 0; r < R; ++r)
+			if (!(first[size_t(r)] < first[size_t(r) + 1]) || first[0] != 0 || first[size_t(R)] != SlabLayout<D>::layers(g))
+				throw InputError("MPI checkpoint resume: the saved slab layout does not fit this grid");
+		L.checkMirrors(g);
+		layout = L;
+		std::vector<uint8_t> go(P.n, 0);
+		for (size_t p = n; p < P.n; ++p) go[p] = 1;
+		keep(P, go);
+		settle(g);
+	}
 	// Before the counting sort: the first call splits the (replicated) scene, later calls migrate.
 	void migrate(const Grid<D>& g, Particles<D>& P)
 	{

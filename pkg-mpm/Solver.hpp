@@ -202,7 +202,6 @@ public:
 	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, rhoMin, massFloor, needSort, needCheck }; }
 	void setResumeState(const ResumeState& r, const std::vector<uint32_t>& blockStart)
 	{
-		MPM_IF_MPI(dd.refuseAfterSplit("setResumeState (checkpoint resume)");)
 		const long s0 = steps;
 		const Real t0 = time, w0 = externalWork;
 		setClock(r.steps, r.time, r.externalWork); // checked before anything else changes

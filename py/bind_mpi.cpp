@@ -30,6 +30,24 @@ bp::dict mpiInfo(Solver<D>& s)
 
 int rank() { return Comm::rank(); }
 int size() { return Comm::size(); }
+double sum(double v) // over the ranks (also a barrier): checkpoint agreement and counts
+{
+	Comm::sum(&v, 1);
+	return v;
+}
+
+// Checkpoint resume (py/yade_mpm/checkpoint.py): the saved slab layout and the rank's particle count; the
+// particle arrays are cut to n (no NumPy view may be alive), then Python writes the saved values into them.
+template <int D>
+void mpiRestoreSlab(Solver<D>& s, bp::object first, long n)
+{
+	if (s.liveViews) throw InputError("MPI checkpoint resume: delete the NumPy views of the particle arrays first");
+	if (n < 0) throw InputError("MPI checkpoint resume: particles = " + std::to_string(n) + " must be ≥ 0");
+	std::vector<int> f;
+	for (long k = 0; k < bp::len(first); ++k) f.push_back(bp::extract<int>(first[k]));
+	s.dd.restore(s.grid, s.P, f, size_t(n));
+	s.requestSort();
+}
 
 } // namespace
 
@@ -47,12 +65,14 @@ void initMpi()
 	}
 	bp::def("mpiRank", &rank, "This process's rank in MPI_COMM_WORLD.");
 	bp::def("mpiSize", &size, "Number of MPI ranks.");
+	bp::def("mpiSum", &sum, "Sum of a float over the MPI ranks (every rank must call it: a collective).");
 }
 
 template <int D>
 void exposeMpi(SolverClass<D>& cls, const char*)
 {
 	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, haloBytesSent.");
+	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, "Checkpoint resume: the saved slab layout and the rank's particle count (yade_mpm.checkpoint).");
 }
 template void exposeMpi<2>(SolverClass<2>&, const char*);
 template void exposeMpi<3>(SolverClass<3>&, const char*);

@@ -185,7 +185,7 @@ expect("stepping with a live view", lambda: s.run(1), "view(s) of the particle a
 del v
 s.run(3)
 expect("addParticles after the split", lambda: s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.2])), "after the first step")
-expect("checkpoint saving", lambda: ym.checkpoint.save("/nonexistent/ck", s), "not supported yet")
+expect("checkpoint saving before the first step", lambda: ym.checkpoint.save("/nonexistent/ck", s1), "save after the first step")
 if rank == 1:   # a bad value on one rank only: every rank stops with a ValueError (none waits forever)
     v = s.view("v0"); v[0] = np.nan; del v
 s.requestSort()

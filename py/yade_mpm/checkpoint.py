@@ -17,7 +17,8 @@ file, another format or build of the core, or another scene (grid, particles, ma
 parameters, YADE bodies and engines) is refused with a ``CheckpointError`` (a ``ValueError``), nothing changed. The
 ``MpmEngine`` registry is restored after ``O.load`` (doc/checkpoint.md). The run-loop side, periodic
 checkpoints and clean stops on SIGINT / SIGTERM, is ``Checkpointer`` and ``ResumableRun`` in
-``yade_mpm.resumable``.
+``yade_mpm.resumable``. On N > 1 MPI ranks: a piece per rank and an index, resumed by the same rank
+count only (``yade_mpm.checkpoint_mpi``).
 """
 import hashlib
 import io
@@ -94,15 +95,22 @@ def _digest(*arrays):
     return h.hexdigest()[:16]
 
 
-def solver_fingerprint(solver):
+def solver_fingerprint(solver, ids=None):
     """What makes a solver's scene this scene and not another: dimension, grid, particle count, the
     particles' masses, initial volumes and surface loads (in id order), the materials, the contact groups'
-    parameters. These never change while stepping: a fresh scene and a checkpoint of it mid-run agree."""
+    parameters. These never change while stepping: a fresh scene and a checkpoint of it mid-run agree.
+    ids: only these particles (MPI: a rank's piece against the freshly built, replicated scene)."""
     arrs = _particle_arrays(solver)
     order = np.argsort(arrs["id"], kind="stable")
+    if ids is not None:
+        ids = np.sort(np.asarray(ids))
+        k = np.clip(np.searchsorted(arrs["id"][order], ids), 0, max(len(order) - 1, 0))
+        if len(order) == 0 or not np.array_equal(arrs["id"][order][k], ids):
+            raise CheckpointError("the checkpoint's particle ids are not all in this scene")
+        order = order[k]
     loads = [arrs[f"trac{a}"][order] for a in range(dim_of(solver)) if f"trac{a}" in arrs]
     return {"dim": dim_of(solver), "origin": list(solver.origin), "spacing": solver.spacing,
-            "cells": list(solver.cells), "particles": int(solver.numParticles),
+            "cells": list(solver.cells), "particles": int(len(order)),
             "arrays": sorted(k for k in arrs if k not in ("id", "material")),
             "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
             "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver.materialKinds],
@@ -210,9 +218,8 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
     the same meta refuses a checkpoint with another one); extra: JSON-able state of the calling script
     (e.g. the curve recorded so far), returned by ``load`` as ``header["extra"]``. Call between steps
     (not from inside a PyRunner). Returns the number of bytes written."""
-    from .parallel import size
-    if size() > 1:   # each rank holds its slab only: per-rank checkpoints are designed, not built (doc/scaling.md)
-        raise ValueError(f"checkpoint: saving under MPI ({size()} ranks) is not supported yet; run on 1 rank to checkpoint")
+    from . import checkpoint_mpi as cmpi
+    mpi = cmpi.active()                           # N > 1 ranks: a piece per rank and an index (checkpoint_mpi)
     if os.path.isdir(path):
         raise ValueError(f"checkpoint path {path} is a directory: give a file name, e.g. {os.path.join(path, 'run.ckpt')}")
     O = _yade_O()
@@ -227,6 +234,8 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
             raise ValueError(f"{name} must be JSON-serialisable (dicts, lists, numbers, strings): {e}") from None
     arrays, header = {}, {"format": FORMAT, "build": build_id(), "written": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
                           "meta": meta, "extra": extra, "solvers": {}, "settings": {}, "yade": None}
+    if mpi:
+        header["mpi"] = {name: cmpi.header_of(s) for name, s in sol.items()}   # a collective: every rank saves
     for name, s in sol.items():
         header["solvers"][name] = solver_fingerprint(s)
         header["settings"][name] = s.settings()   # JSON floats round-trip exactly
@@ -241,6 +250,12 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
         engines = _engines_in_scene(O)
         header["yade"] = dict(yade_fingerprint(O), mpm_engines={lab: dict(e.checkpoint_state(), solver=next((k for k, v in sol.items() if v is e.solver), None))
                                                                  for lab, e in engines.items()})
+    if not mpi:
+        return _write(path, header, arrays)
+    return cmpi.save_pieces(path, header, arrays, sol, _write)
+
+
+def _write(path, header, arrays):
     buf = io.BytesIO()
     np.savez(buf, **arrays)
     payload = buf.getvalue()
@@ -262,9 +277,9 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
 
 
 # -------------------------------------------------------------------------------------------- load
-def read(path):
-    """(header, arrays) of a checkpoint file after checking magic, format, build, length and checksum;
-    raises CheckpointError naming the problem."""
+def read(path, check_build=True):
+    """(header, arrays) of a checkpoint file after checking magic, format, build (unless check_build is
+    False: the caller checks it), length and checksum; raises CheckpointError naming the problem."""
     try:
         with open(path, "rb") as f:
             raw = f.read()
@@ -288,10 +303,8 @@ def read(path):
         raise CheckpointError(f"checkpoint {path}: format version {header.get('format')}, this yade_mpm reads version {FORMAT} "
                               "only (checkpoints are not converted between formats: rerun from the start, or resume with the "
                               "yade_mpm version that wrote it)")
-    if header.get("build") != build_id():
-        raise CheckpointError(f"checkpoint {path}: written by another build of the yade_mpm core ({header.get('build')}, "
-                              f"this one is {build_id()}); a bitwise resume needs the same build — rerun from the start "
-                              "or rebuild the version that wrote it")
+    if check_build:
+        _check_build(path, header)
     payload = raw[p + 8 + hl:]
     if len(payload) != header.get("payload_bytes"):
         raise CheckpointError(f"checkpoint {path}: truncated or padded (payload {len(payload)} bytes, "
@@ -301,6 +314,13 @@ def read(path):
     with np.load(io.BytesIO(payload), allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
     return header, arrays
+
+
+def _check_build(path, header):
+    if header.get("build") != build_id():
+        raise CheckpointError(f"checkpoint {path}: written by another build of the yade_mpm core ({header.get('build')}, "
+                              f"this one is {build_id()}); a bitwise resume needs the same build — rerun from the start "
+                              "or rebuild the version that wrote it")
 
 
 def _diff(a, b, prefix=""):
@@ -322,7 +342,16 @@ def load(path, solvers=None, yade=None, meta=None):
     created); yade: restore the YADE scene (None = if the checkpoint has one); meta: if given, must
     equal the meta stored by ``save``. Everything is checked before anything changes; on mismatch a
     CheckpointError lists the differences. Returns the header (meta, time written, fingerprints)."""
-    header, arrays = read(path)
+    header, arrays = read(path, check_build=False)
+    from . import checkpoint_mpi as cmpi
+    cmpi.refuse_other_count(path, header, CheckpointError)   # N ranks resume only an N-rank checkpoint (before the build:
+    _check_build(path, header)                               # 1 process and N ranks run different builds of the core)
+    if cmpi.active():
+        return cmpi.load_piece(path, header, solvers, yade, meta)
+    return _load(path, header, arrays, solvers, yade, meta)
+
+
+def _load(path, header, arrays, solvers, yade, meta, mpi=None):
     if meta is not None and json.loads(json.dumps(meta)) != header.get("meta"):
         raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(_diff(header.get("meta"), json.loads(json.dumps(meta)), "meta.")))
     saved_yade = header.get("yade")
@@ -355,7 +384,13 @@ def load(path, solvers=None, yade=None, meta=None):
         raise ValueError("solvers must be None, a Solver2D/3D or a {name: solver} dict")
     problems = []
     for n, s in sol.items():
-        problems += _diff(header["solvers"][n], solver_fingerprint(s), f"solver {n}: ")
+        ids = arrays[f"solver/{n}/id"] if mpi else None          # MPI: this rank's particles of the fresh scene
+        if mpi and mpi[n]["total"] != s.numParticles:
+            problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks in the checkpoint, {s.numParticles} in this scene")
+        try:
+            problems += _diff(header["solvers"][n], solver_fingerprint(s, ids), f"solver {n}: ")
+        except CheckpointError as e:
+            problems.append(f"solver {n}: {e}")
         saved, here = sorted(header["settings"][n]), sorted(s.settings())
         if saved != here:
             problems.append(f"solver {n}: settings {saved} in the checkpoint, {here} in this core")
@@ -363,10 +398,16 @@ def load(path, solvers=None, yade=None, meta=None):
         here = yade_fingerprint(O)
         if here["bodies"] or here["engines"]:     # a scene was built: it must be the saved one
             problems += _diff({k: saved_yade[k] for k in ("bodies", "engines")}, here, "YADE ")
+    if mpi is not None:                           # every rank's checks passed, or every rank refuses
+        from .checkpoint_mpi import agree
+        if not agree(not problems) and not problems:
+            problems.append("another MPI rank refused its piece (its message names the difference)")
     if problems:
         raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(problems[:8])
                               + (f" (+{len(problems) - 8} more)" if len(problems) > 8 else ""))
     for n, s in sol.items():                      # every check passed: now change the state
+        if mpi:                                   # the slab layout; the arrays cut to this rank's particles
+            s._mpiRestoreSlab(mpi[n]["firstLayers"], mpi[n]["particles"])
         _restore_solver(s, {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")}, header["settings"][n])
     if with_yade:
         d = os.path.dirname(os.path.abspath(path))

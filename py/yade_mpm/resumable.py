@@ -40,6 +40,15 @@ def parse_every(text, option="--checkpoint-every"):
     raise ValueError(f"{option} = {text!r} must be a step count ≥ 0 (0: only at the end) or wall minutes like '10min'")
 
 
+def _any_rank(flag):
+    """`flag` on any MPI rank (a collective under MPI; the flag itself on one process)."""
+    from . import parallel
+    if parallel.size() == 1:
+        return bool(flag)
+    from . import _core
+    return _core.mpiSum(1.0 if flag else 0.0) > 0
+
+
 class Checkpointer:
     """Periodic checkpoints and clean stops for a run loop.
 
@@ -78,8 +87,9 @@ class Checkpointer:
         return self.every_minutes is not None and time.time() - self.last_wall >= 60 * self.every_minutes
 
     def tick(self, step):
-        """Save if a checkpoint is due at this step. Returns True if one was written."""
-        if self.due(step):
+        """Save if a checkpoint is due at this step. Returns True if one was written. MPI: due on any rank
+        (wall minutes differ between ranks) is due on every rank (a collective: every rank ticks)."""
+        if _any_rank(self.due(step)):
             self.save(step)
             return True
         return False
@@ -97,7 +107,8 @@ class Checkpointer:
         """A ``runner.Output`` that checks every `steps` steps: writes a checkpoint when one is due and
         ends the run (``runner.STOP``, so the run's at_end outputs are written) after SIGINT/SIGTERM."""
         def check(solver):
-            if self.stop_requested:
+            if _any_rank(self.stop_requested):    # MPI: a signal seen by one rank stops every rank
+                self.stop_requested = True
                 return STOP
             self.tick(solver.steps)
             return None
