@@ -10,8 +10,8 @@ the same place). Two modes:
 global: the same on every rank) and the first step at which this rank held a particle with D = 1 (checked
 every 10 steps, as scripts/tunnel_spalling.py does) with those particles' ids. `compare` takes the global
 first crack (the earliest rank's step; the union of the ranks that cracked at that step), its place
-(``cases.tunnel_where`` of the initial positions, as ``tunnel_results.first_crack``) and the mean stress
-over 0.01 mm of displacement around 0.5, 1 and 2 mm (``scripts/tunnel_spalling.py``'s record step)."""
+(``cases.tunnel_where`` of the initial positions, as ``tunnel_results.first_crack``) and the axial stress
+at 0.5, 1 and 2 mm read as ``scripts/tunnel_spalling.py`` reads it (``stress_at``)."""
 import argparse
 import glob
 import json
@@ -65,11 +65,24 @@ def load(folder):
         pts = parts[0]["x0"][ids]
         crack = dict(step=k, time_ms=float(curve[k - 1, 0]) * 1e3, displacement_mm=float(curve[k - 1, 1]) * 1e3, particles=len(ids),
                      centroid_mm=(pts.mean(axis=0) * 1e3).tolist(), location=cases.tunnel_where(pts, None))
-    stress = {}
-    for d in AT_MM:
-        m = np.abs(curve[:, 1] * 1e3 - d) < BIN_MM / 2
-        stress[d] = float(curve[m, 2].mean()) if m.any() else float("nan")
+    stress = stress_at(curve)
     return dict(ranks=len(parts), steps=len(curve), wall_s=[float(p["wall"]) for p in parts], stress_Pa=stress, first_crack=crack)
+
+
+def stress_at(curve):
+    """Axial stress [Pa] at AT_MM as scripts/tunnel_spalling.py (and scripts/regress.py) read it: the mean
+    over every BIN_MM of platen travel (``output.CurveRecorder`` replayed on the per-step record), sampled
+    every 0.1 mm (``tunnel_results.sample_curve``)."""
+    from yade_mpm import output
+    from yade_mpm.cases import tunnel_results
+    row = [0]
+    rec = output.CurveRecorder(lambda: curve[row[0], 1], lambda: curve[row[0], 2], BIN_MM * 1e-3)
+    clock = type("Clock", (), {})()
+    for row[0] in range(len(curve)):
+        clock.time = curve[row[0], 0]
+        rec.record(clock)
+    at = {round(p["displacement_mm"], 6): p["stress_MPa"] * 1e6 for p in tunnel_results.sample_curve(rec.state["curve"], 0.1)}
+    return {d: at.get(d, float("nan")) for d in AT_MM}
 
 
 def compare(a):
