@@ -3,11 +3,11 @@
 // calls gridPhases, then particlePhases; the loops live in the headers named on the right.
 //
 //   phase          what it computes                                             paper          where
-//   1 P2G          m_i = Σ ξ m_p, Σ w m_p, p_i = Σ ξ m_p h_p(x_i),              Eqs. 16, 20–22 Transfer::p2g
-//                  f_i = −Σ V_p σ_p ∇ψ_i + Σ ξ m_p g + traction
+//   1 P2G          m_i = Σ η m_p, Σ w m_p, p_i = Σ η m_p h_p(x_i),              Eqs. 16, 20–22 Transfer::p2g
+//                  f_i = −Σ V_p σ_p ∇ψ_i + Σ η m_p g + traction
 //   2 grid update  v_i = (p_i + Δt f_i)/m_i, local damping, boundary planes     Eq. 18         gridUpdate
 //   3 contact      PTS correction of v_i by the rigid bodies, body reactions    Eqs. 23–26     ContactPhase::apply
-//   4 G2P          v_p = Σ ξ_i v_i, C_p = Σ v_i ⊗ ∇ψ_i;                         Eqs. 6–7       Transfer::g2p
+//   4 G2P          v_p = Σ η_i v_i, C_p = Σ v_i ⊗ ∇ψ_i;                         Eqs. 6–7       Transfer::g2p
 //                  MUSL momentum mom_i = Σ_p w m_p h_p(x_i)                     Eq. 16
 //   5 MUSL remap   ṽ_i = mom_i / Σ_p w m_p, boundary planes                     Eq. 17         gridMusl (below)
 //   6 stress       ∇ṽ_p = Σ ṽ_i ⊗ ∇ψ_i, Δε = sym(∇ṽ_p) Δt, Jaumann rotation,    Eqs. 7, 29,    updateStress,

@@ -219,7 +219,7 @@ public:
 							if (st.w[n] == 0) continue;
 							const size_t i = st.base + offs.off[n];
 							// Eq. 23 with the fit ψ_i: the force acts at x_p (Σ ψ_i x_i = x_p). Lumped like the mass
-							// (ξ_i, WlsShape.hpp) it would act at x̄_p, inside the material: a column with three
+							// (η_i, WlsShape.hpp) it would act at x̄_p, inside the material: a column with three
 							// contact faces measured 1.107 M/L instead of 0.97 (tests/test_contact_initial_d0.py).
 							for (int a = 0; a < D; ++a) A.fn[a][i] += st.psi[n] * fp[a];
 							A.load[i] += st.w[n] * wn * fmag;

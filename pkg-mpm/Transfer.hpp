@@ -142,8 +142,8 @@ public:
 				}
 				Stencil<D> st;
 				if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
-				// Cut stencil: mass, momentum and external force lumped with ξ ≥ 0 (WlsShape.hpp), the particle's
-				// velocity v_p standing at the centroid x̄_p = x_p + dbar of its weights (Σ ξ (x_i − x̄_p) = 0:
+				// Cut stencil: mass, momentum and external force lumped with η ≥ 0 (WlsShape.hpp), the particle's
+				// velocity v_p standing at the centroid x̄_p = x_p + dbar of its weights (Σ η (x_i − x̄_p) = 0:
 				// momentum conserved); internal force with the fitted ∇ψ (Σ_i ∇ψ_i = 0).
 				forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
 					const Real xi = st.xi[n];
@@ -185,7 +185,7 @@ public:
 			}
 			Stencil<D> st;
 			if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
-			// Cut stencil: v_p = Σ ξ_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum conserved;
+			// Cut stencil: v_p = Σ η_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum conserved;
 			// exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 			// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
 			forStencil(grid.vel.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {

@@ -20,7 +20,7 @@ struct Stencil {
 	Real   psi[N];     // ψ_i(x_p), Eq. 15
 	Real   grad[N][D]; // ∇ψ_i(x_p)
 	Real   xi[N];      // η_i: non-negative lumping weights of a cut stencil (below; = ψ_i = w_i in the interior)
-	Real   dbar[D];    // x̄_p − x_p, x̄_p = Σ ξ_i x_i the centroid of the lumping weights (0 in the interior)
+	Real   dbar[D];    // x̄_p − x_p, x̄_p = Σ η_i x_i the centroid of the lumping weights (0 in the interior)
 	bool   general;    // true when M was assembled from a reduced node set
 
 	// Offset of stencil node n from the base along each axis.
@@ -143,18 +143,19 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 	// row-sum lumped mass Σ_p m_p ψ_i of Eq. 20 can be negative or vanish next to excluded nodes, and a node of
 	// negative mass accelerates against its force (the corner-particle blow-up next to a body). The paper's lumping
 	// is meant to be positive (text after Eq. 22, Hinton et al. 1976). Mass, momentum and external forces are lumped
-	// with η_i = ½ (w_i/Σ_active w + |ψ_i|/Σ_j |ψ_j|) ≥ 0 (Σ η = 1: mass and momentum conserved; = ψ_i = w_i for a
-	// full stencil, Eq. 20 unchanged). The first half (Shepard weights, as the MUSL remap, Eq. 17) gives every node
-	// the particle touches a mass ≥ ½ ξ_i m_p: none vanishes. The second half gives a node at least half the share
-	// |ψ_i|/Σ|ψ| of the particle's mass that it takes of the particle's forces (penalty Eq. 23 with ψ_i, internal
-	// force Eq. 21 with ∇ψ_i): with the Shepard weights alone a far active node with a small w_i on which a one-sided
-	// fit leans (ψ_i ≫ ξ_i) carried a tiny mass and a large force, a local mode with (ωΔt)² ≈ 3 of the explicit limit
-	// 4 (doc/contact.md, "Contact wherever the grid cuts a body"). ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).
-	Real wsum = 0, asum = 0;
-	for (int n = 0; n < N; ++n) wsum += st.w[n], asum += std::abs(st.psi[n]);
+	// with η_i = ½ (w_i/Σ_active w + ψ⁺_i/Σ_j ψ⁺_j) ≥ 0, ψ⁺ = max(ψ, 0) (Σ η = 1: mass and momentum conserved;
+	// = ψ_i = w_i for a full stencil, Eq. 20 unchanged). The first half (Shepard weights, as the MUSL remap, Eq. 17)
+	// gives every node the particle touches a mass ≥ ½ ξ_i m_p: none vanishes. The second half is Eq. 20's own
+	// weights without their negative parts: a node on which the one-sided fit leans (ψ_i ≫ ξ_i) gets at least half the
+	// share of the particle's mass that it takes of its forces (penalty Eq. 23 with ψ_i, internal force Eq. 21 with
+	// ∇ψ_i). With the Shepard weights alone such a node beside a block's corner, a small w_i and ψ_i = 0.6, carried a
+	// tiny mass and a large force: a local mode at (ωΔt)² ≈ 3 of the explicit limit 4 (doc/contact.md, "Contact
+	// wherever the grid cuts a body"). ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).
+	Real wsum = 0, psum = 0;
+	for (int n = 0; n < N; ++n) wsum += st.w[n], psum += std::max(st.psi[n], Real(0));
 	for (int a = 0; a < D; ++a) st.dbar[a] = 0;
 	for (int n = 0; n < N; ++n) {
-		st.xi[n] = 0.5 * (std::abs(st.psi[n]) / asum + st.w[n] / wsum);
+		st.xi[n] = 0.5 * (std::max(st.psi[n], Real(0)) / psum + st.w[n] / wsum);
 		for (int a = 0; a < D; ++a) st.dbar[a] += st.xi[n] * st.d[a][Stencil<D>::along(n, a)];
 	}
 	return true;

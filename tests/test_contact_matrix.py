@@ -1,8 +1,8 @@
 """Contact wherever the grid cuts a body (issue 17): the same scene on 8 positions of the grid under it.
 
 Next to a body the WLS fit runs over the active nodes only and its ψ_i extrapolate (partly negative); the
-lumped masses are taken with the non-negative weights η_i = ½ (w_i/Σ w + |ψ_i|/Σ|ψ|) (WlsShape.hpp), so no node
-mass is negative or vanishes and no corner particle blows up. Bars of the issue (corners, a free body in a slot and
+lumped masses are taken with the non-negative weights η_i = ½ (w_i/Σ w + ψ⁺_i/Σ ψ⁺), ψ⁺ = max(ψ, 0) (WlsShape.hpp), so
+no node mass is negative or vanishes and no corner particle blows up. Bars of the issue (corners, a free body in a slot and
 C = 1 at the platen corner: tests/test_contact_corners.py):
 - sliding: |a/a_exact − 1| ≤ 3 % for every θ/μ/shift, a_exact = g(sin θ − μ cos θ);
 - sticking from gravity equilibrium: drift ≤ 1 % of a cell over 0.3 s (2D; 3D over 0.15 s); 4 % below the friction
