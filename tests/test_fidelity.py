@@ -156,3 +156,12 @@ def test_reference_crit_strain_matches_the_reference_codes_softening_rate():
         assert m.cohesion * kphi / m.critPlasticStrain == pytest.approx(m.cohesion / (math.sqrt(3) * e), rel=1e-12)
         assert e == pytest.approx(expect, abs=2e-4)
 
+
+def test_every_tunnel_variant_builds_a_valid_flaw_at_the_default_grid():
+    # the scene refuses a flaw within one cell of a face or the opening (arch_tunnel's range check): a variant must pass it
+    from yade_mpm.cases.tunnel import _flaw_clear
+    for name, v in fidelity.VARIANTS.items():
+        if v.get("scene") == "tunnel" and "flaw_angle" in v:
+            assert _flaw_clear(math.radians(v["flaw_angle"]), 0.002), name
+    assert not _flaw_clear(math.radians(45.0), 0.002)
+

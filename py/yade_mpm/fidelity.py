@@ -114,7 +114,8 @@ VARIANTS = {
                             label="ε̄p grown as in the reference code (Graphyt: Δε̄p = k̄φ Δλ, not Δλ/√3): Eq. 34 then softens as "
                                   "ε̄p,crit = 0.1/(√3 k̄φ) does here (0.051 at φ = 39°, 0.050 at 38°)"),
     "floor_52.5mm": dict(floor=0.0525, scene="tunnel", label="opening's floor at 52.5 mm (centred 45 mm-high opening) instead of 55 mm"),
-    "flaw_angle_45": dict(flaw_angle=45.0, scene="tunnel", label="flaw inclined 45° instead of 60° (the paper gives no angle)"),
+    "flaw_angle_50": dict(flaw_angle=50.0, scene="tunnel", label="flaw inclined 50° instead of 60° (the paper gives no angle; "
+                          "45° is refused at 2 mm: its tip comes within a cell of the left face)"),
     "flaw_gap_5mm": dict(flaw_toe_gap=0.005, scene="tunnel", label="flaw toe 5 mm from the left wall instead of 10 mm (position not given)"),
     "flaw_toe_waist": dict(flaw_toe_height=0.0125, scene="tunnel",
                            label="flaw toe at mid-wall height (12.5 mm above the floor) instead of spandrel height (25 mm; not given)"),
