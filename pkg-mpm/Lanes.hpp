@@ -11,6 +11,8 @@
 
 namespace mpm {
 
+typedef Real Lane4Mem __attribute__((vector_size(32), may_alias)); // 4 lanes of a node in memory
+
 // Lane vector of a node: m, mw, momentum…, force… (zero padding in 2D).
 template <int D>
 inline NodeLanes nodeLanes(Real m, Real mw, const Real (&a)[D], const Real (&b)[D])
@@ -26,7 +28,10 @@ inline void forRows(const Grid<D>& g, const Kernel<D>& k, F&& f)
 {
 	const size_t sy = g.stride[1];
 	if constexpr (D == 2) {
-		for (int j = 0; j < 4; ++j) f(k.base + j * sy, k.w[1][j], &k.d[1][j]);
+		for (int j = 0; j < 4; ++j) {
+			const Real dr[1] = { k.d[1][j] };
+			f(k.base + j * sy, k.w[1][j], dr);
+		}
 	} else {
 		const size_t sz = g.stride[2];
 		for (int l = 0; l < 4; ++l)
@@ -38,11 +43,22 @@ inline void forRows(const Grid<D>& g, const Kernel<D>& k, F&& f)
 }
 
 // Interior scatter of an affine field: node i of the stencil receives w_i (base + Σ_b slope_b (x_i − x_p)_b),
-// expanded row by row (the x-layer is the innermost loop).
-template <int D>
+// expanded row by row (the x-layer is the innermost loop). low4 (2D, fused P2G): only lanes 0–3 (m, mw,
+// p + Δt f) are non-zero, so the row is updated as 4-lane vectors.
+template <int D, bool low4 = false>
 inline void scatterAffine(Grid<D>& g, const Kernel<D>& k, const NodeLanes& base, const NodeLanes* slope)
 {
 	auto& nodes = g.nodes;
+	if constexpr (low4 && D == 2) {
+		const Lane4 b0 = __builtin_shufflevector(base, base, 0, 1, 2, 3), s0 = __builtin_shufflevector(slope[0], slope[0], 0, 1, 2, 3),
+		            s1 = __builtin_shufflevector(slope[1], slope[1], 0, 1, 2, 3);
+		const Lane4 wd = k.w[0] * k.d[0];
+		forRows(g, k, [&](size_t row, Real wr, const Real* dr) {
+			const Lane4 R = (b0 + s1 * dr[0]) * wr, S = s0 * wr;
+			for (int i = 0; i < 4; ++i) *reinterpret_cast<Lane4Mem*>(&nodes[row + i]) += k.w[0][i] * R + wd[i] * S;
+		});
+		return;
+	}
 	forRows(g, k, [&](size_t row, Real wr, const Real* dr) {
 		NodeLanes R = base;
 		for (int b = 1; b < D; ++b) R += slope[b] * dr[b - 1];
@@ -68,7 +84,7 @@ struct PackedRow {
 	typedef Real L2 __attribute__((vector_size(16)));
 	explicit PackedRow(const Kernel<D>& k)
 	{
-		const L4 w = *reinterpret_cast<const L4*>(k.w[0]), wd = w * *reinterpret_cast<const L4*>(k.d[0]);
+		const L4 w = k.w[0], wd = w * k.d[0];
 		if constexpr (S == 2) {
 			wx[0] = __builtin_shufflevector(w, w, 0, 0, 1, 1, 2, 2, 3, 3), wxd[0] = __builtin_shufflevector(wd, wd, 0, 0, 1, 1, 2, 2, 3, 3);
 		} else {

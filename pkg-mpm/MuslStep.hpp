@@ -76,7 +76,7 @@ inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<
 	Grid<D>& grid = xfer.grid;
 #pragma omp parallel
 	{
-		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, errP2G); // 1: Eqs. 20–22
+		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, in.dt, in.damping == 0, errP2G); // 1: Eqs. 20–22 (no damping: p + Δt f fused)
 		sumShared(grid.nodes, errP2G, "P2G");                            // MPI: + neighbours' partial sums
 		if (in.mirrors) grid.foldMirrors(grid.nodes);                    // symmetry planes: add the reflected images
 		stampTime(t[1]);

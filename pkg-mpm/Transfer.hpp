@@ -81,17 +81,26 @@ public:
 	// P0 = [m, m, m v, f_ext] and A_b = [0, 0, m C_·b, −V σ_·b 3/l²] (interior particles, where
 	// ∇ψ_i = w_i 3/l² (x_i − x_p)); particles with a general WLS stencil go through the full ψ, ∇ψ.
 	// Sign of Eq. 21 in code: stress is tension-positive and f_int,i = −Σ_p V_p σ_p ∇ψ_i(x_p).
+	// fused (no damping, which needs the force alone): the momentum lanes receive p + Δt f (Eq. 18's
+	// numerator) and the force lanes stay 0, so in 2D P2G updates 4 lanes per node (m, mw, p + Δt f)
+	// instead of 8: P0 = [m, m, m v + Δt f_ext], A_b = [0, 0, m C_·b − Δt V σ_·b 3/l²]. gridUpdate then
+	// reads v = (p + Δt f)/m + Δt·0/m.
 	// loadScale multiplies the particle surface forces (traction ramp). viewWrites: state may have been
 	// written through NumPy views since the last step, so positions are checked against their block's
 	// reach and mass and volume against (0, inf) (compile-time: a step without views pays nothing).
 	template <class Mat>
-	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, bool viewWrites, ErrorRecord& err)
+	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, bool viewWrites, Real dt, bool fused, ErrorRecord& err)
 	{
-		if (viewWrites) p2g<true>(mat, gravity, loadScale, err);
-		else p2g<false>(mat, gravity, loadScale, err);
+		if (fused) {
+			if (viewWrites) p2g<true, true>(mat, gravity, loadScale, dt, err);
+			else p2g<false, true>(mat, gravity, loadScale, dt, err);
+		} else {
+			if (viewWrites) p2g<true, false>(mat, gravity, loadScale, dt, err);
+			else p2g<false, false>(mat, gravity, loadScale, dt, err);
+		}
 	}
-	template <bool checkViews, class Mat>
-	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, ErrorRecord& err)
+	template <bool checkViews, bool fused, class Mat>
+	void p2g(const Mat& mat, const Vec& gravity, Real loadScale, Real dt, ErrorRecord& err)
 	{
 		auto& nodes = grid.nodes;
 #pragma omp for schedule(static)
@@ -127,6 +136,19 @@ public:
 				if (!k.general) {
 					Real sgm[D][D];
 					sym2full(sg, sgm);
+					if constexpr (fused) {
+						Real q[D], zero[D] = {};
+						for (int a = 0; a < D; ++a) q[a] = mv[a] + dt * fe[a]; // p + Δt f_ext
+						const NodeLanes P0 = nodeLanes<D>(m, m, q, zero);
+						NodeLanes       A[D];
+						for (int b = 0; b < D; ++b) {
+							Real ca[D];
+							for (int a = 0; a < D; ++a) ca[a] = mC[a][b] - dt * V * Dinv * sgm[a][b]; // Eq. 21 × Δt, fused
+							A[b] = nodeLanes<D>(0, 0, ca, zero);
+						}
+						scatterAffine<D, true>(grid, k, P0, A);
+						return;
+					}
 					const NodeLanes P0 = nodeLanes<D>(m, m, mv, fe); // lanes: m, mw, momentum…, force…
 					NodeLanes       A[D];
 					for (int b = 0; b < D; ++b) {
@@ -154,8 +176,11 @@ public:
 					for (int a = 0; a < D; ++a) {
 						Real mom = mv[a];
 						for (int b = 0; b < D; ++b) mom += mC[a][b] * (dx[b] - st.dbar[b]);
-						nd.p[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
-						nd.f[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+						if constexpr (fused) nd.p[a] += xi * mom + dt * (-V * sg_g[a] + xi * fe[a]); // p + Δt f
+						else {
+							nd.p[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
+							nd.f[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+						}
 					}
 				});
 			});

@@ -47,11 +47,12 @@ struct StencilOffsets {
 // because there ψ_i = w_i = Π_a w1[a][i_a] and ∇ψ_i = w_i·3/l²·(x_i − x_p): the kernels expand the
 // products row by row instead of storing 4^D values. `general` marks particles that need the full
 // WLS stencil (reduced node set, Eqs. 10–15).
+typedef Real Lane4 __attribute__((vector_size(32))); // the 4 stencil layers of one axis
 template <int D>
 struct Kernel {
-	size_t            base;    // linear index of stencil node (0,0[,0])
-	alignas(32) Real  w[D][4]; // one-dimensional cubic B-spline weights, Eq. 13
-	alignas(32) Real  d[D][4]; // x_i − x_p per axis for the 4 stencil layers [m]
+	size_t base; // linear index of stencil node (0,0[,0])
+	Lane4  w[D]; // one-dimensional cubic B-spline weights, Eq. 13 (vectors: kept in registers)
+	Lane4  d[D]; // x_i − x_p per axis for the 4 stencil layers [m]
 	bool   general; // some stencil node is excluded (any bit of Grid::excluded): use fillStencil's general path
 	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
@@ -72,11 +73,11 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 		const Real t = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
 		// the 4 weights as cubics in t (Horner, one vector): w0 = (1−t)³/6, w1 = t³/2 − t² + 2/3,
 		// w2 = −t³/2 + t²/2 + t/2 + 1/6, w3 = t³/6; offsets x_i − x_p = (j − 1 − t) l
-		typedef Real L4 __attribute__((vector_size(32)));
+		typedef Lane4 L4;
 		const L4 c3 = { -1.0 / 6, 0.5, -0.5, 1.0 / 6 }, c2 = { 0.5, -1.0, 0.5, 0.0 }, c1 = { -0.5, 0.0, 0.5, 0.0 };
 		const L4 c0 = { 1.0 / 6, 2.0 / 3, 1.0 / 6, 0.0 }, jm = { -1.0, 0.0, 1.0, 2.0 };
-		*reinterpret_cast<L4*>(k.w[a]) = ((c3 * t + c2) * t + c1) * t + c0;
-		*reinterpret_cast<L4*>(k.d[a]) = (jm - t) * h;
+		k.w[a] = ((c3 * t + c2) * t + c1) * t + c0;
+		k.d[a] = (jm - t) * h;
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
 	k.base    = base;
