@@ -21,7 +21,9 @@ struct alignas(64) Node {
 	Real p[D]; // momentum
 	Real f[D]; // force
 };
-typedef Real NodeLanes __attribute__((vector_size(64), may_alias));
+// Lane vectors of doubles alias doubles (GCC gives a vector type its element's alias set), not the pointers
+// of the particle arrays: no may_alias, so stores to nodes do not force the array pointers to be reloaded.
+typedef Real NodeLanes __attribute__((vector_size(64)));
 static_assert(sizeof(Node<2>) == sizeof(NodeLanes) && sizeof(Node<3>) == sizeof(NodeLanes), "a node must fill one lane vector");
 template <int D>
 inline NodeLanes& lanes(Node<D>& n) { return *reinterpret_cast<NodeLanes*>(&n); }
@@ -36,7 +38,7 @@ struct alignas(D == 2 ? 16 : 32) NodeVec { // aligned as its lane vector (C++17 
 };
 template <int D>
 struct NodeVecLanesOf {
-	typedef Real type __attribute__((vector_size(sizeof(NodeVec<D>)), may_alias));
+	typedef Real type __attribute__((vector_size(sizeof(NodeVec<D>))));
 };
 template <int D>
 using NodeVecLanes = typename NodeVecLanesOf<D>::type;

@@ -11,7 +11,7 @@
 
 namespace mpm {
 
-typedef Real Lane4Mem __attribute__((vector_size(32), may_alias)); // 4 lanes of a node in memory
+typedef Real Lane4Mem __attribute__((vector_size(32))); // 4 lanes of a node in memory
 
 // Lane vector of a node: m, mw, momentum…, force… (zero padding in 2D).
 template <int D>
@@ -75,7 +75,7 @@ inline void scatterAffine(Grid<D>& g, const Kernel<D>& k, const NodeLanes& base,
 // The 4 nodes of a stencil row along x hold 4·S contiguous values (S = 2 in 2D, 4 in 3D): one or two
 // 8-lane vectors. A gather sums the rows first (weights along y[, z]) and the 4 nodes along x last (lanes);
 // a scatter adds a precomputed per-node pattern to each row: a few vector operations per row, not per node.
-typedef Real RowLanes __attribute__((vector_size(64), aligned(8), may_alias)); // unaligned 8-lane view
+typedef Real RowLanes __attribute__((vector_size(64), aligned(8))); // unaligned 8-lane view (aliases doubles only)
 template <int D>
 struct PackedRow {
 	static constexpr int S = NodeVec<D>::S, R = 4 * S / 8; // values per node, lane vectors per row

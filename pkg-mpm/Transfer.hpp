@@ -69,11 +69,13 @@ public:
 	{
 		scatterBlocks([&](uint32_t b) { forBlock(b, f); });
 	}
+	// checked = false: inside the grid for sure (G2P and the stress pass, after P2G accepted the positions).
+	template <bool checked = true>
 	void kernelOf(size_t p, Kernel<D>& k) const
 	{
 		Real x[D];
 		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
-		computeKernel(grid, offs, x, k);
+		computeKernel<D, checked>(grid, offs, x, k);
 	}
 
 	// ------------------------------------------------------------ P2G: Eqs. 20–22
@@ -194,7 +196,7 @@ public:
 	{
 		scatterPass([&](size_t p) {
 			Kernel<D> k;
-			kernelOf(p, k);
+			kernelOf<false>(p, k);
 			const Real m = P.mass[p];
 			Real       v[D] = {}, C[D][D] = {};
 			if (!k.general) {
@@ -236,7 +238,7 @@ public:
 	bool velocityGradient(size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D]) const
 	{
 		Kernel<D> k;
-		kernelOf(p, k);
+		kernelOf<false>(p, k);
 		general = k.general;
 		if (!k.general) {
 			Real v[D];

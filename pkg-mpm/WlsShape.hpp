@@ -57,7 +57,9 @@ struct Kernel {
 	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
 
-template <int D>
+// checked: x may lie anywhere (k.inside tells); unchecked (G2P and the stress pass of a step whose P2G
+// accepted every position, which do not move before the step ends): x lies inside the physical grid.
+template <int D, bool checked = true>
 inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Kernel<D>& k)
 {
 	const Real h = g.spacing, invH = 1.0 / g.spacing;
@@ -65,11 +67,12 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 	k.inside            = true;
 	for (int a = 0; a < D; ++a) {
 		Real f = (x[a] - g.origin[a]) * invH;
-		if (!(f >= 0 && f < g.cells[a])) { // also catches NaN: positions edited through views
-			k.inside = false;
-			return;
-		}
-		const int  c = int(std::floor(f));
+		if constexpr (checked)
+			if (!(f >= 0 && f < g.cells[a])) { // also catches NaN: positions edited through views
+				k.inside = false;
+				return;
+			}
+		const int  c = int(f); // f ≥ 0: truncation is the floor
 		const Real t = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
 		// the 4 weights as cubics in t (Horner, one vector): w0 = (1−t)³/6, w1 = t³/2 − t² + 2/3,
 		// w2 = −t³/2 + t²/2 + t/2 + 1/6, w3 = t³/6; offsets x_i − x_p = (j − 1 − t) l
