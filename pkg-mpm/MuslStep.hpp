@@ -15,7 +15,8 @@
 //   7 move         x_p ← x_p + Δt v_p, stability and re-sort checks                            moveParticles
 //
 // Each node array holds one quantity, written by one phase (Grid.hpp, GridNode.hpp):
-//   nodes {m, mw, p, f}  P2G      vel  grid update (+ contact)      mom  G2P      vmusl  MUSL remap
+//   nodes {m, mw, p, f}  P2G (no damping: p + Δt f, f = 0)
+//       vel  grid update (+ contact)      mom  G2P      vmusl  MUSL remap
 // (gridUpdate also clears mom for G2P: one pass over the nodes.) With symmetry planes, nodal sums are
 // folded onto the physical nodes after each scatter and the nodes beyond the planes are filled again
 // after each nodal update (MirrorPlanes.hpp). h_p(x) = v_p + C_p (x − x_p): the particle's linear
