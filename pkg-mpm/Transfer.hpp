@@ -170,18 +170,18 @@ public:
 				// velocity v_p standing at the centroid x̄_p = x_p + dbar of its weights (Σ η (x_i − x̄_p) = 0:
 				// momentum conserved); internal force with the fitted ∇ψ (Σ_i ∇ψ_i = 0).
 				forStencil(nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
-					const Real xi = st.xi[n];
-					nd.m += xi * m;       // Eq. 20, positive lumping
+					const Real eta = st.eta[n];
+					nd.m += eta * m;       // Eq. 20, positive lumping
 					nd.mw += st.w[n] * m; // Σ w m, denominator of Eq. 17
 					Real sg_g[D];
 					stressTimesVector(sg, st.grad[n], sg_g);
 					for (int a = 0; a < D; ++a) {
 						Real mom = mv[a];
 						for (int b = 0; b < D; ++b) mom += mC[a][b] * (dx[b] - st.dbar[b]);
-						if constexpr (fused) nd.p[a] += xi * mom + dt * (-V * sg_g[a] + xi * fe[a]); // p + Δt f
+						if constexpr (fused) nd.p[a] += eta * mom + dt * (-V * sg_g[a] + eta * fe[a]); // p + Δt f
 						else {
-							nd.p[a] += xi * mom;                  // momentum of the affine velocity field (Eq. 16)
-							nd.f[a] += -V * sg_g[a] + xi * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
+							nd.p[a] += eta * mom;                 // momentum of the affine velocity field (Eq. 16)
+							nd.f[a] += -V * sg_g[a] + eta * fe[a]; // Eq. 21 (f_int = −Σ V σ ∇ψ) + Eq. 22
 						}
 					}
 				});
@@ -217,7 +217,7 @@ public:
 			// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
 			forStencil(grid.vel.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
 				for (int a = 0; a < D; ++a) {
-					v[a] += st.xi[n] * nd.c[a];                                    // Eq. 6 with positive weights
+					v[a] += st.eta[n] * nd.c[a];                                    // Eq. 6 with positive weights
 					for (int b = 0; b < D; ++b) C[a][b] += nd.c[a] * st.grad[n][b]; // Eq. 7
 				}
 			});

@@ -19,7 +19,7 @@ struct Stencil {
 	Real   w[N];       // B-spline weight w_i(x_p), Eq. 12
 	Real   psi[N];     // ψ_i(x_p), Eq. 15
 	Real   grad[N][D]; // ∇ψ_i(x_p)
-	Real   xi[N];      // η_i: non-negative lumping weights of a cut stencil (below; = ψ_i = w_i in the interior)
+	Real   eta[N];     // η_i: non-negative lumping weights of a cut stencil (below; = ψ_i = w_i in the interior)
 	Real   dbar[D];    // x̄_p − x_p, x̄_p = Σ η_i x_i the centroid of the lumping weights (0 in the interior)
 	bool   general;    // true when M was assembled from a reduced node set
 
@@ -111,7 +111,7 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 		const Real s = 3.0 * invH * invH;
 		for (int a = 0; a < D; ++a) st.dbar[a] = 0; // Σ w_i (x_i − x_p) = 0 for the full B-spline stencil
 		for (int n = 0; n < N; ++n) {
-			st.psi[n] = st.xi[n] = st.w[n];
+			st.psi[n] = st.eta[n] = st.w[n];
 			for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * s * st.d[a][Stencil<D>::along(n, a)];
 		}
 		return true;
@@ -159,8 +159,8 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 	for (int n = 0; n < N; ++n) wsum += st.w[n], psum += std::max(st.psi[n], Real(0));
 	for (int a = 0; a < D; ++a) st.dbar[a] = 0;
 	for (int n = 0; n < N; ++n) {
-		st.xi[n] = 0.5 * (std::max(st.psi[n], Real(0)) / psum + st.w[n] / wsum);
-		for (int a = 0; a < D; ++a) st.dbar[a] += st.xi[n] * st.d[a][Stencil<D>::along(n, a)];
+		st.eta[n] = 0.5 * (std::max(st.psi[n], Real(0)) / psum + st.w[n] / wsum);
+		for (int a = 0; a < D; ++a) st.dbar[a] += st.eta[n] * st.d[a][Stencil<D>::along(n, a)];
 	}
 	return true;
 }
