@@ -20,14 +20,17 @@ struct DpGkMat : ElasticMat {
 		if (plasticity && softeningModulusTerm() >= shear())
 			throw InputError(
 			        "critPlasticStrain = " + ParamInfo::num(critPlasticStrain)
-			        + " gives cohesion softening steeper than the shear modulus allows (k̄φ·c₀/(√3·ε̄p,crit) must be < G); raise critPlasticStrain");
+			        + " gives cohesion softening steeper than the shear modulus allows (k̄φ·c₀·r/ε̄p,crit must be < G, r = dε̄p/dΔλ = "
+			        + ParamInfo::num(epsPerLambda()) + " for plasticStrainIncrement = '" + paramWord(plasticStrainIncrement) + "'); raise critPlasticStrain");
 	}
 	// Eq. 31 (outer-apex Mohr–Coulomb match) and Eq. 33.
 	Real qPhi() const { return 6 * std::sin(frictionAngle) / (std::sqrt(3.0) * (3 - std::sin(frictionAngle))); }
 	Real kPhi() const { return 6 * std::cos(frictionAngle) / (std::sqrt(3.0) * (3 - std::sin(frictionAngle))); }
 	Real qPsi() const { return 6 * std::sin(dilationAngle) / (std::sqrt(3.0) * (3 - std::sin(dilationAngle))); }
-	// |k̄φ H|/√3, H = dc/dε̄p in the softening branch.
-	Real softeningModulusTerm() const { return kPhi() * cohesion / critPlasticStrain / std::sqrt(3.0); }
+	// dε̄p/dΔλ (plasticStrainIncrement): k̄φ (the reference code's) or 1/√3 (von Mises equivalent).
+	Real epsPerLambda() const { return plasticStrainIncrement == PlasticStrainIncrement::VonMises ? 1 / std::sqrt(3.0) : kPhi(); }
+	// |k̄φ H| dε̄p/dΔλ, H = dc/dε̄p in the softening branch.
+	Real softeningModulusTerm() const { return kPhi() * cohesion / critPlasticStrain * epsPerLambda(); }
 	// Eq. 34.
 	Real cohesionAt(Real epsP) const { return std::max(cohesion * (1 - epsP / critPlasticStrain), residualCohesion * cohesion); }
 	Real effectiveCrackSpeed() const { return crackSpeed > 0 ? crackSpeed : 0.4 * pWaveSpeed(); }
@@ -122,7 +125,7 @@ struct ReturnInfo {
 template <int D>
 struct DruckerPragerGradyKipp {
 	DpGkMat mat;
-	Real    K, G, M, qphi, kphi, qpsi, cFloor, epsFloor, H, alpha13, cg, E, nu;
+	Real    K, G, M, qphi, kphi, qpsi, rate, cFloor, epsFloor, H, alpha13, cg, E, nu;
 	Real    cell; // grid spacing l [m] (threshold readings that depend on it)
 
 	explicit DruckerPragerGradyKipp(const DpGkMat& m, Real gridSpacing = 0) : mat(m), cell(gridSpacing)
@@ -135,6 +138,7 @@ struct DruckerPragerGradyKipp {
 		qphi     = m.qPhi();
 		kphi     = m.kPhi();
 		qpsi     = m.qPsi();
+		rate     = m.epsPerLambda();
 		cFloor   = m.residualCohesion * m.cohesion;
 		epsFloor = (1 - m.residualCohesion) * m.critPlasticStrain; // ε̄p where Eq. 34 reaches the floor
 		H        = -m.cohesion / m.critPlasticStrain;              // dc/dε̄p before the floor
@@ -142,8 +146,8 @@ struct DruckerPragerGradyKipp {
 		cg       = m.effectiveCrackSpeed();
 	}
 
-	// DP plastic corrector (Eqs. 30–34). ε̄p grows by the von Mises equivalent of the plastic
-	// deviatoric strain, Δε̄p = √(2/3)‖Δε^p_dev‖ = Δλ/√3 on the cone.
+	// DP plastic corrector (Eqs. 30–34). ε̄p grows by rate·Δλ (plasticStrainIncrement): k̄φΔλ as the
+	// reference code (Graphyt druckerPrager_Damage) or Δλ/√3 = √(2/3)‖Δε^p_dev‖ (von Mises equivalent).
 	ReturnInfo plasticReturn(Sym<D>& s, Real& epsP) const
 	{
 		ReturnInfo r;
@@ -153,12 +157,11 @@ struct DruckerPragerGradyKipp {
 		const Real c   = mat.cohesionAt(epsP);
 		const Real F   = tau + qphi * sm - kphi * c; // Eq. 30
 		if (F <= 0) return r;
-		const Real s3 = std::sqrt(3.0);
 		// Cone return with the non-associated potential (Eqs. 32–33): τ ← τ − GΔλ, σm ← σm − K qψ Δλ.
 		Real dl;
 		if (epsP < epsFloor) {
-			dl = F / (G + K * qphi * qpsi + kphi * H / s3);
-			if (epsP + dl / s3 > epsFloor) // passes the 0.1 c₀ floor inside this step
+			dl = F / (G + K * qphi * qpsi + kphi * H * rate);
+			if (epsP + rate * dl > epsFloor) // passes the 0.1 c₀ floor inside this step
 				dl = (tau + qphi * sm - kphi * cFloor) / (G + K * qphi * qpsi);
 		} else {
 			dl = F / (G + K * qphi * qpsi);
@@ -167,18 +170,19 @@ struct DruckerPragerGradyKipp {
 		if (tauNew >= 0) {
 			r.mode    = 1;
 			r.dLambda = dl;
-			epsP += dl / s3;
+			epsP += rate * dl;
 			const Real scale = tau > 0 ? tauNew / tau : 0;
 			const Real smNew = sm - K * qpsi * dl;
 			for (int k = 0; k < Dim<D>::nSym; ++k) s.c[k] = dev.c[k] * scale;
 			for (int k = 0; k < 3; ++k) s.c[k] += smNew;
 			return r;
 		}
-		// Apex return: the whole trial deviator is plastic, Δε̄p = τ/(√3 G); σm lands on the apex of
-		// the softened cone, σm = k̄φ c / qφ (qφ > 0 here, otherwise the cone return is always valid).
+		// Apex return: the whole trial deviator is plastic, Δλ = τ/G and Δε̄p = rate·τ/G (the cone's measure,
+		// continuous with it where τ − GΔλ = 0); σm lands on the apex of the softened cone, σm = k̄φ c / qφ
+		// (qφ > 0 here, otherwise the cone return is always valid).
 		r.mode    = 2;
 		r.dLambda = tau / G;
-		epsP += tau / (s3 * G);
+		epsP += rate * tau / G;
 		const Real smApex = kphi * mat.cohesionAt(epsP) / qphi;
 		for (int k = 0; k < Dim<D>::nSym; ++k) s.c[k] = 0;
 		for (int k = 0; k < 3; ++k) s.c[k] = smApex;

@@ -27,6 +27,13 @@ enum class DamageGrowthLaw : int {
 	AsPrinted   = 1  // dD^{1/3}/dt = ⅓ c_g α^{1/3} ε̄^{1/3}: Eq. 38 exactly as printed
 };
 MPM_CHOICES(DamageGrowthLaw, "benz-asphaug|as-printed")
+// Growth of ε̄p per plastic step (Eq. 34 softens with ε̄p; the paper does not define the increment, it cites
+// Deb & Pramanik 2013). Δλ is the plastic multiplier of Eqs. 32–33 (τ ← τ − GΔλ).
+enum class PlasticStrainIncrement : int {
+	ReferenceCode = 0, // Δε̄p = k̄φ Δλ: the reference code's (Graphyt ConstitutiveModels.cpp, druckerPrager_Damage)
+	VonMises      = 1  // Δε̄p = Δλ/√3 = √(2/3)‖Δε^p_dev‖: von Mises equivalent of the deviatoric plastic strain
+};
+MPM_CHOICES(PlasticStrainIncrement, "reference-code|von-mises")
 } // namespace mpm
 
 // X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
@@ -47,6 +54,11 @@ MPM_CHOICES(DamageGrowthLaw, "benz-asphaug|as-printed")
 	X(Real, cohesion, MPM_REQUIRED, "Pa", 0, INFINITY, OO, "c₀", "initial cohesion", "Eq. 34", "plasticity")                    \
 	X(Real, critPlasticStrain, 0.1, "-", 0, INFINITY, OO, "ε̄p,crit", "accumulated plastic strain at which cohesion softening ends", \
 	  "Eq. 34", "plasticity")                                                                                                    \
+	X(PlasticStrainIncrement, plasticStrainIncrement, PlasticStrainIncrement::ReferenceCode, "-", 0, 1, CC, "Δε̄p",              \
+	  "growth of ε̄p per plastic step (the paper leaves it open): 'reference-code' = k̄φ·Δλ as the reference code grows it "    \
+	  "(Graphyt, ConstitutiveModels.cpp, druckerPrager_Damage: acc_plastic_strain += dL·ξ), 'von-mises' = Δλ/√3, the von Mises " \
+	  "equivalent of the deviatoric plastic strain (this code's earlier default); Δλ is Eq. 32's plastic multiplier, the apex " \
+	  "return uses Δλ = τ/G; not a calibration; see doc/damage_growth_law.md", "Eq. 34", "plasticity")                                    \
 	X(Real, residualCohesion, 0.1, "-", 0, 1, CC, "", "cohesion floor as a fraction of c₀ (paper: 0.1)", "Eq. 34", "plasticity") \
 	X(Real, weibullK, MPM_REQUIRED, "m^-3", 0, INFINITY, OO, "k", "Weibull flaw density", "Eqs. 37, 39", "damage")              \
 	X(Real, weibullM, MPM_REQUIRED, "-", 1, 50, CC, "m", "Weibull modulus", "Eqs. 37–39", "damage")                              \
