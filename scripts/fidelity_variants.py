@@ -50,9 +50,6 @@ def parse():
 
 def build(a, v):
     mat = dict(v.get("material", {}))
-    if v.get("eps_p_reference"):             # the reference code's ε̄p increment, as an equivalent ε̄p,crit
-        base = rocks.pan2020_sandstone() if a.scene == "tunnel" else rocks.miao2018_sandstone()
-        mat["critPlasticStrain"] = fidelity.reference_crit_strain(base)
     if a.scene == "tunnel":
         s, b = cases.arch_tunnel(a.case, a.spacing, material=rocks.pan2020_sandstone(**mat), floor=v.get("floor", cases.TUNNEL_FLOOR),
                                  flaw_angle=math.radians(v.get("flaw_angle", cases.FLAW_ANGLE_DEG)), flaw_toe_gap=v.get("flaw_toe_gap", cases.FLAW_TOE_GAP),

@@ -66,10 +66,17 @@ def upd(m, stress, de, epsP=0.0, D=0.0, eps0=1.0, dt=1e-6):
     return np.array(s), np.array(sd), e, d, mode, dl
 
 
-def independent_return(trial, eps, ecrit=0.1, c0=C0):
-    """Independent DP cone return: root of F(σ(Δλ), c(ε̄p + Δλ/√3)) = 0 by bisection, with
-    σ(Δλ) = σ_tr − Δλ C:∂g/∂σ and g = τ + qψ σm (Eqs. 30–34). Returns (stress, Δλ, ε̄p) or None if
+# dε̄p/dΔλ of DpGkMat.plasticStrainIncrement, written out again: the reference code's k̄φ (Graphyt,
+# ConstitutiveModels.cpp, druckerPrager_Damage: acc_plastic_strain += dL·ξ) and the von Mises equivalent
+# of the deviatoric plastic strain, √(2/3)‖Δε^p_dev‖ = √(2/3)·Δλ/√2 = Δλ/√3.
+INCREMENTS = {"reference-code": KPHI, "von-mises": 1 / math.sqrt(3)}
+
+
+def independent_return(trial, eps, ecrit=0.1, c0=C0, inc="reference-code"):
+    """Independent DP cone return: root of F(σ(Δλ), c(ε̄p + r Δλ)) = 0 by bisection, r = INCREMENTS[inc],
+    with σ(Δλ) = σ_tr − Δλ C:∂g/∂σ and g = τ + qψ σm (Eqs. 30–34). Returns (stress, Δλ, ε̄p) or None if
     the cone return is not admissible (τ would turn negative)."""
+    rate = INCREMENTS[inc]
     tau, sm, s = invariants(trial)
     dgds = s / (2 * tau) + QPSI / 3 * np.eye(3)
     corr = 2 * G * (dgds - np.trace(dgds) / 3 * np.eye(3)) + K * np.trace(dgds) * np.eye(3)
@@ -77,7 +84,7 @@ def independent_return(trial, eps, ecrit=0.1, c0=C0):
     def F(dl):
         t2, m2, _ = invariants(trial - dl * corr)
         t2 = tau - G * dl  # signed τ along the path (the norm hides the sign past the apex)
-        return t2 + QPHI * m2 - KPHI * cohesion(eps + dl / math.sqrt(3), ecrit, c0)
+        return t2 + QPHI * m2 - KPHI * cohesion(eps + rate * dl, ecrit, c0)
 
     lo, hi = 0.0, tau / G
     if F(hi) > 0:
@@ -86,7 +93,7 @@ def independent_return(trial, eps, ecrit=0.1, c0=C0):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if F(mid) > 0 else (lo, mid)
     dl = 0.5 * (lo + hi)
-    return trial - dl * corr, dl, eps + dl / math.sqrt(3)
+    return trial - dl * corr, dl, eps + rate * dl
 
 
 def yield_value(stress, eps, ecrit=0.1):
@@ -126,6 +133,15 @@ def test_bad_input_names_the_parameter():
         mat(critPlasticStrain=1e-5)   # softening steeper than G
     with pytest.raises(ValueError, match="growthLaw"):
         mat(growthLaw=2)
+    with pytest.raises(ValueError, match=r"DpGkMat.plasticStrainIncrement must be one of 'reference-code' or 'von-mises' \(got str vonMises\)"):
+        mat(plasticStrainIncrement="vonMises")
+    with pytest.raises(ValueError, match="plasticStrainIncrement must be one of"):
+        mat(plasticStrainIncrement=1)          # no integer codes
+    # the softening bound depends on the increment: k̄φ c₀ r/ε̄p,crit < G
+    e_ok = 1.05 * KPHI * C0 * INCREMENTS["von-mises"] / G
+    mat(critPlasticStrain=e_ok, plasticStrainIncrement="von-mises")
+    with pytest.raises(ValueError, match="critPlasticStrain.*plasticStrainIncrement = 'reference-code'"):
+        mat(critPlasticStrain=e_ok)
     with pytest.raises(ValueError, match="weibullM"):
         mat(weibullM=0.0)
 
@@ -146,9 +162,15 @@ def test_elastic_trial_inside_surface_is_returned_unchanged(n):
 
 
 # ------------------------------------------------------------------ cone return, Eqs. 30–33
+def test_default_increment_is_the_reference_codes():
+    assert mat().plasticStrainIncrement == "reference-code"
+    assert ym.DpGkMat(**P).plasticStrainIncrement == "reference-code"
+
+
+@pytest.mark.parametrize("inc", sorted(INCREMENTS))
 @pytest.mark.parametrize("n", [4, 6])
-def test_cone_return_lands_on_surface_along_q_psi(n):
-    m = mat(damage=False)
+def test_cone_return_lands_on_surface_along_q_psi(n, inc):
+    m = mat(damage=False, plasticStrainIncrement=inc)
     s0 = np.array([-30e6, -30e6, -30e6, 0, 0, 0][:n])
     de = 3 * np.array([-2e-3, 1e-3, 0.0, 1.5e-3, 4e-4, -3e-4][:n])
     if n == 4:
@@ -166,14 +188,22 @@ def test_cone_return_lands_on_surface_along_q_psi(n):
     assert tt - tn == pytest.approx(G * dl, rel=1e-10)
     assert mt - mn == pytest.approx(K * QPSI * dl, rel=1e-10)
     assert (mt - mn) / (tt - tn) == pytest.approx(K * QPSI / G, rel=1e-10)
-    # ε̄p = von Mises equivalent of the plastic deviatoric strain, √(2/3)|Δε^p_dev| = Δλ/√3
+    # ε̄p from the plastic deviatoric strain of the returned stress: ‖Δε^p_dev‖ = Δλ/√2
     dep_dev = (st - sn) / (2 * G)
-    assert e == pytest.approx(math.sqrt(2 / 3 * np.sum(dep_dev * dep_dev)), rel=1e-10)
-    # the independent bisection return agrees
-    ref = independent_return(trial, 0.0)
+    norm = math.sqrt(np.sum(dep_dev * dep_dev))
+    if inc == "von-mises":
+        assert e == pytest.approx(math.sqrt(2 / 3) * norm, rel=1e-10)    # von Mises equivalent
+    else:
+        assert e == pytest.approx(KPHI * math.sqrt(2) * norm, rel=1e-10)  # k̄φ Δλ
+    # the independent bisection return agrees (its softening uses the same increment)
+    ref = independent_return(trial, 0.0, inc=inc)
     assert ref is not None
     np.testing.assert_allclose(s, compact(ref[0], n), rtol=0, atol=1e-7 * C0)
     assert dl == pytest.approx(ref[1], rel=1e-9)
+    assert e == pytest.approx(ref[2], rel=1e-9)
+    # the other increment gives a different Δλ (softening depends on it): the test can tell them apart
+    other = independent_return(trial, 0.0, inc=[k for k in INCREMENTS if k != inc][0])
+    assert abs(other[1] - dl) > 1e-6 * dl
 
 
 def test_associated_flow_when_psi_equals_phi():
@@ -187,8 +217,9 @@ def test_associated_flow_when_psi_equals_phi():
 
 
 # ------------------------------------------------------------------ apex return
-def test_apex_return_for_tension_beyond_the_apex():
-    m = mat(damage=False)
+@pytest.mark.parametrize("inc", sorted(INCREMENTS))
+def test_apex_return_for_tension_beyond_the_apex(inc):
+    m = mat(damage=False, plasticStrainIncrement=inc)
     apex = KPHI * C0 / QPHI          # σm of the cone apex [Pa]
     # pure hydrostatic tension beyond the apex, plus a small shear: the cone return would need τ < 0
     s0 = [apex * 1.5, apex * 1.5, apex * 1.5, 1e6]
@@ -196,7 +227,7 @@ def test_apex_return_for_tension_beyond_the_apex():
     assert mode == 2
     assert independent_return(full(s0), 0.0) is None      # the cone return is indeed inadmissible
     tau = invariants(full(s0))[0]
-    assert e == pytest.approx(tau / (math.sqrt(3) * G), rel=1e-12)
+    assert e == pytest.approx(INCREMENTS[inc] * tau / G, rel=1e-12)   # Δλ = τ/G, the cone's measure
     c = cohesion(e)
     np.testing.assert_allclose(s, [KPHI * c / QPHI] * 3 + [0.0], rtol=1e-12, atol=1e-6)
     assert abs(yield_value(s, e)) < 1e-8 * KPHI * C0
@@ -207,9 +238,10 @@ def test_apex_return_for_tension_beyond_the_apex():
 
 
 # ------------------------------------------------------------------ softening, Eq. 34
-def test_softening_reaches_the_floor_exactly_and_stays():
+@pytest.mark.parametrize("inc", sorted(INCREMENTS))
+def test_softening_reaches_the_floor_exactly_and_stays(inc):
     ecrit = 0.01
-    m = mat(damage=False, critPlasticStrain=ecrit)
+    m = mat(damage=False, critPlasticStrain=ecrit, plasticStrainIncrement=inc)
     s = np.array([-40e6, -40e6, -40e6, 0.0])
     eps, prev_eps, floor_hit = 0.0, 0.0, None
     de = np.array([-4e-4, 4e-4, 0, 3e-4])    # plane-strain shear with a little compression
@@ -230,27 +262,29 @@ def test_softening_reaches_the_floor_exactly_and_stays():
     assert tau == pytest.approx(KPHI * 0.1 * C0 - QPHI * sm, rel=1e-8)
 
 
-def test_floor_crossing_step_matches_independent_return():
+@pytest.mark.parametrize("inc", sorted(INCREMENTS))
+def test_floor_crossing_step_matches_independent_return(inc):
     ecrit = 0.01
-    m = mat(damage=False, critPlasticStrain=ecrit)
+    m = mat(damage=False, critPlasticStrain=ecrit, plasticStrainIncrement=inc)
     eps0 = 0.0085                                       # 0.0005 before the floor at 0.009
     s0 = np.array([-20e6, -20e6, -20e6, 0.0])
     de = np.array([-2e-3, 2e-3, 0, 2e-3])
     s, _, e, _, mode, dl = upd(m, s0, de, epsP=eps0)
-    ref = independent_return(hooke(s0, de), eps0, ecrit)
+    ref = independent_return(hooke(s0, de), eps0, ecrit, inc=inc)
     assert mode == 1 and e > 0.009
     np.testing.assert_allclose(s, compact(ref[0], 4), rtol=0, atol=1e-7 * C0)
     assert e == pytest.approx(ref[2], rel=1e-9)
 
 
 # ------------------------------------------------------------------ plane-strain compression path
-def test_plane_strain_compression_path_against_independent_integration():
+@pytest.mark.parametrize("inc", sorted(INCREMENTS))
+def test_plane_strain_compression_path_against_independent_integration(inc):
     """Biaxial plane-strain compression: σxx held at −5 MPa by solving for Δεxx each increment,
     εyy shortened in 400 increments, εzz = 0. The MPM point update and an independent integration
     (Hooke + bisection return written above) must give the same path; before yield the path must
     match plane-strain elasticity, σyy − σxx0 = E/(1 − ν²)·εyy."""
     ecrit = 0.02
-    m = mat(damage=False, critPlasticStrain=ecrit)
+    m = mat(damage=False, critPlasticStrain=ecrit, plasticStrainIncrement=inc)
     conf = -5e6
     s = np.array([conf, conf, conf, 0.0])        # start hydrostatic (σzz = confinement too)
     r = full(s)
@@ -273,7 +307,7 @@ def test_plane_strain_compression_path_against_independent_integration():
         # independent integration with the same strain increment
         tr = hooke(compact(r, 4), [dxx, dyy, 0, 0])
         if yield_value(compact(tr, 4), eps_r, ecrit) > 0:
-            rr = independent_return(tr, eps_r, ecrit)
+            rr = independent_return(tr, eps_r, ecrit, inc=inc)
             r, eps_r = rr[0], rr[2]
         else:
             r = tr

@@ -146,15 +146,12 @@ def test_table_rows_from_constructed_summaries():
     assert all(r["default"] for r in rows) and {r["verdict"] for r in rows if r["part"] == "circular_opening"} == {"not run"}
 
 
-def test_reference_crit_strain_matches_the_reference_codes_softening_rate():
-    # Graphyt: c = c0 (1 − ε̄p/ε_crit) with Δε̄p = k̄φ Δλ; here Δε̄p = Δλ/√3: equal dc/dΔλ needs ε' = ε_crit/(√3 k̄φ)
-    for phi_deg, expect in ((39.0, 0.0508), (38.0, 0.0504)):
-        m = rocks.pan2020_sandstone(frictionAngle=math.radians(phi_deg))
-        s, c = math.sin(m.frictionAngle), math.cos(m.frictionAngle)
-        kphi = 6 * c / (math.sqrt(3) * (3 - s))
-        e = fidelity.reference_crit_strain(m)
-        assert m.cohesion * kphi / m.critPlasticStrain == pytest.approx(m.cohesion / (math.sqrt(3) * e), rel=1e-12)
-        assert e == pytest.approx(expect, abs=2e-4)
+def test_von_mises_variant_is_the_named_option_and_the_default_is_the_reference_codes():
+    v = fidelity.variant("eps_p_von_mises", "tunnel")
+    assert v["material"] == dict(plasticStrainIncrement="von-mises")
+    assert rocks.pan2020_sandstone(**v["material"]).plasticStrainIncrement == "von-mises"
+    assert rocks.pan2020_sandstone().plasticStrainIncrement == "reference-code"
+    assert rocks.miao2018_sandstone().plasticStrainIncrement == "reference-code"
 
 
 def test_every_tunnel_variant_builds_a_valid_flaw_at_the_default_grid():
