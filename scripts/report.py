@@ -352,6 +352,9 @@ def fidelity_section(R):
         + (" Paper grid: " + ", ".join(f"{v} {k}" for k, v in sorted(npg.items())) + f" of the {sum(npg.values())} rows run there." if npg else ""), "")
 
 
+OLD_INCREMENT = "fidelity_variants_b86bf5e.md"    # the variant matrix run with Δε̄p = Δλ/√3 (before issue 18's default), kept verbatim
+
+
 def variant_matrix(R, folder="fidelity_variants"):
     """Choice × row: the one-at-a-time variants (scripts/fidelity_variants.py), each against its own baseline."""
     files = sorted(glob.glob(os.path.join(R.root, folder, "*.json")))
@@ -367,6 +370,10 @@ def variant_matrix(R, folder="fidelity_variants"):
         R.w("Variants not in the matrix below (uniaxial growth law, V = dp³, residual cohesion, ε̄p,crit = 0.01, tunnel intact at "
             "2.5 mm) were screened on an older build (before issue 17's contact fix): "
             "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
+    if os.path.exists(os.path.join(REPO, "doc", OLD_INCREMENT)):
+        R.w("Variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) on the "
+            "tunnel filled flaw — Eq. 36 as the principal strain, the opening centred, the flaw toe 5 mm from the wall — are kept "
+            f"verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}); not re-run on this build.", "")
     notes = os.path.join(R.root, folder, "notes.md")
     if os.path.exists(notes):
         R.w(open(notes).read().rstrip(), "")
