@@ -113,7 +113,7 @@ VARIANTS = {
     "soft_strain_0.01": dict(material=dict(critPlasticStrain=0.01), label="ε̄p,crit = 0.01 instead of 0.1 (softening within reach of the grid's strains)"),
     "eps_p_von_mises": dict(material=dict(plasticStrainIncrement="von-mises"),
                             label="ε̄p grown by the von Mises equivalent of the deviatoric plastic strain, Δε̄p = Δλ/√3 (this code's "
-                                  "earlier default) instead of the reference code's k̄φ Δλ (1.97× faster softening at φ = 39°)"),
+                                  "earlier default) instead of the reference code's k̄φ Δλ (which softens 1.97× faster at φ = 39°)"),
     "floor_52.5mm": dict(floor=0.0525, scene="tunnel", label="opening's floor at 52.5 mm (centred 45 mm-high opening) instead of 55 mm"),
     "flaw_angle_50": dict(flaw_angle=50.0, scene="tunnel", label="flaw inclined 50° instead of 60° (the paper gives no angle; "
                           "45° is refused at 2 mm: its tip comes within a cell of the left face)"),

@@ -200,8 +200,8 @@ def u_scatter(u):
 PAPER_UNIAXIAL = ("not run: at 0.5 mm the open-flaw scene has 119,200 particles (16× 2 mm's) and 8,460 steps per ms (4×), "
                   "64× the particle-steps; a 0.1 ms probe ran 1.38 M particle-steps/s on one shared thread, so one run to its "
                   "post-peak stop (≈ 75,000 steps) needs ≈ 110 min, over the session's budget")
-PAPER_TUNNEL = ("not run at l = 1 mm with this build; the last 1 mm runs (same simulation code) are in "
-                "doc/paper_grid_and_courant_7ac11e5.md")
+PAPER_TUNNEL = ("not run at l = 1 mm with this build; the last 1 mm runs (an earlier build, ε̄p grown by the von Mises "
+                "Δλ/√3 before issue 18) are in doc/paper_grid_and_courant_7ac11e5.md")
 PAPER_BENCH = "benchmarks: the paper's grid is the convergence study's finest point where run"
 
 ROWS = [  # fig, claim, part, measure
