@@ -7,8 +7,8 @@ results stay within these tolerances of the numbers a reference build stored:
 
     Kirsch (circular opening, 2.4 m block, l = 0.04 m, 8 ms of damped relaxation): the four L2 errors of σxx, σyy on the x and y
         lines                                                       relative change ≤ 1e-3
-    Sneddon (pressurised line crack, 2.5 m block, l = 0.04 m): centre opening error and L2 opening
-        error                                                       relative change ≤ 1e-3
+    Sneddon (pressurised line crack, 2.5 m block, l = 0.04 m, 5 P-wave transits of damped loading): centre
+        opening error and L2 opening error                          relative change ≤ 1e-3
     tunnel, default 2 mm grid, intact: axial stress at 0.5, 1 and 2 mm of platen travel    ≤ 0.5 %
         first crack (first particle at D = 1): time ≤ 2 %; location, each coordinate within 2 % of
         the 150 mm specimen (3 mm), same place (floor, roof, wall); damage symmetry at 8 ms          absolute change ≤ 0.02
@@ -48,8 +48,10 @@ CASES = {
     # a fixed simulated time (tol never met): the default stop "changes < tol" ends at a step that moves with the last bit
     "kirsch": ("circular_opening.py", ["--domain", "2.4", "--spacing", "0.04", "--no-vtu", "--progress", "600", "--tol", "1e-12",
                                        "--max-time", "0.008"]),
+    # a fixed time too: the default stop (the centre opening settled, sampled every quarter transit) moved from step 608
+    # to 576 with a last-bit change, and the opening still creeps then (L2 error 0.0625 → 0.0621)
     "sneddon": ("penny_crack.py", ["--parts", "elastic", "--size", "2.5", "--spacing", "0.04", "--progress", "600",
-                                   "--crack-nodes", "shared"]),
+                                   "--crack-nodes", "shared", "--elastic-tol", "1e-12", "--elastic-max-transits", "5"]),
     "tunnel": ("tunnel_spalling.py", ["--cases", "intact", "--checkpoint-every", "0", "--vtu-every", "1", "--progress", "600"]),
     "uniaxial": ("uniaxial_flaw.py", ["--runs", "intact,open,filled:0.4:0", "--vtu-every", "1", "--progress", "600"]),
 }
