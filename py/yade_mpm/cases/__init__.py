@@ -8,6 +8,7 @@ scenes here and keep only their command line, plots and narrative.
     arch_tunnel_specimen(spacing, ...)  the tunnel specimen with its opening and slip walls (no top load)
     arch_tunnel(case, spacing, ...)  paper Sec. 4 + grout: the full scene with the YADE platen (and filler)
     uniaxial_flaw(variant, spacing, ...)  paper Sec. 3.3: 50 × 150 mm specimen, platen, open/rigid-filled flaw
+                      (slab_cells = n: the same as a 3D slab between slip planes; slab_compare: its curve vs 2D)
     yade_platen / yade_filler / yade_engines   the rigid YADE bodies and engines of those loading scenes
     tunnel_location / tunnel_where / tunnel_report   names of places around the tunnel, its crack analytics
     tunnel_results    a tunnel run's records: first crack, snapshots and their analysis, summary entry,
@@ -29,5 +30,5 @@ from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW
                      TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
                      arch_tunnel, arch_tunnel_holes, arch_tunnel_specimen, tunnel_fidelity, tunnel_flaw, tunnel_flaw_at, tunnel_location,
                      tunnel_opening_distance, tunnel_report, tunnel_where)
-from .uniaxial import (UNIAXIAL_FLAW, UNIAXIAL_HEIGHT, UNIAXIAL_PAPER_SPACING, UNIAXIAL_SIDE_ROOM, UNIAXIAL_VARIANTS,
+from .uniaxial import (UNIAXIAL_FLAW, UNIAXIAL_HEIGHT, UNIAXIAL_PAPER_SPACING, UNIAXIAL_SIDE_ROOM, UNIAXIAL_SLAB_CELLS, UNIAXIAL_VARIANTS,
                        UNIAXIAL_MAX_SPACING, UNIAXIAL_WIDTH, exclude_nodes_inside, uniaxial_flaw, uniaxial_flaw_geometry)

@@ -8,17 +8,18 @@ FILLER_CHI = 0.5                   # filler–rock residual penetration factor �
 BODY_HALF_THICKNESS = 0.5          # YADE box half-extent along z [m]: thickness 1 m
 
 
-def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0):
+def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0, d0=None):
     """A rigid YADE Box platen resting on the specimen top y = `top` [m] (its lower face there: the top
     particle row is then at the default detection distance, half a particle edge), 1.2 × `width` wide
     and 10 cells high, blockedDOFs 'xyzXYZ', moving down at `speed` [m/s]; registered in the
-    RigidBodies `rb` with μ = friction [-], c = cohesion [Pa]. Returns its YADE id."""
+    RigidBodies `rb` with μ = friction [-], c = cohesion [Pa], detection distance d0 (None: half the
+    particle edge, ``RigidBodies.add``). Returns its YADE id."""
     from yade import O, utils
     hp = 5 * spacing                               # platen half-height
     pid = O.bodies.append(utils.box((x_center, top + hp, 0), (0.6 * width, hp, BODY_HALF_THICKNESS), fixed=False))
     O.bodies[pid].state.blockedDOFs = "xyzXYZ"
     O.bodies[pid].state.vel = (0, -speed, 0)
-    rb.add(pid, mu=friction, cohesion=cohesion)
+    rb.add(pid, mu=friction, cohesion=cohesion, d0=d0)
     return pid
 
 

@@ -17,6 +17,7 @@ UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
 UNIAXIAL_VARIANTS = ("intact", "open", "filled")
 UNIAXIAL_MAX_SPACING = UNIAXIAL_WIDTH / 10   # coarsest grid [m]: 10 cells across the specimen (a coarser one ran with 3–5 particles)
 UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face [m]: spalled fragments (measured up to 14 m/s) stay on the grid
+UNIAXIAL_SLAB_CELLS = 2            # thickness of the 3D slab (slab_cells > 0) in grid cells [-] (doc/three_d.md)
 
 
 def uniaxial_flaw_geometry(width=UNIAXIAL_WIDTH, height=UNIAXIAL_HEIGHT, flaw=UNIAXIAL_FLAW):
@@ -41,7 +42,8 @@ def exclude_nodes_inside(solver, polygon):
 
 def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
                   platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY",
-                  ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM):
+                  ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM, slab_cells=0,
+                  platen_d0=None):
     """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
     ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
@@ -57,11 +59,18 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     Grady–Kipp activation strain ε_D⁰ = 0.99 (Eq. 37) that tension never reaches — "end caps", so the layer
     under the penalty contact does not crack first (doc/mpm_vs_bonded.md); 0 (default) = none.
     side_room [m] > 0: grid beyond each free side face (default UNIAXIAL_SIDE_ROOM).
+    slab_cells ≥ 0: 0 (default) = 2D plane strain; n > 0 = the same specimen as a 3D slab n cells thick
+    (z ∈ [0, n·l]) between two slip (symmetry) planes on its front and back faces, i.e. plane strain
+    imposed by the boundary instead of the kinematics (doc/three_d.md); the flaw is a through prism and the
+    platen spans the slab (1 m along z); variants "intact" and "open". The 2D parameters above hold unchanged.
+    platen_d0: the platen's contact detection distance [m] (None, default: half the particle edge ½V^(1/D) of
+    the current volume, which differs between 2D and 3D once the volume changes; a number makes a slab
+    and the 2D run identical to roundoff, doc/three_d.md).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
-    rigid (RigidBodies), engine (MpmEngine), flaw (dict or None), width, height [m],
-    axial_stress() -> platen reaction / width [Pa, compression positive],
+    rigid (RigidBodies), engine (MpmEngine), flaw (dict or None), width, height, thickness [m] (2D: 1 m),
+    axial_stress() -> platen reaction / (width × thickness) [Pa, compression positive],
     axial_strain() -> platen displacement / height [-],
     advance(n) -> sets the (ramped) platen speed for the time O.time, then runs n steps)."""
     if variant not in UNIAXIAL_VARIANTS:
@@ -79,14 +88,23 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         raise ValueError(f"ramp_time = {ramp_time!r} s must be a finite number ≥ 0")
     end_cap_cells = _integer(end_cap_cells, "end_cap_cells", 0, math.ceil(H / (2 * spacing)) - 1)
     side_room = _number(side_room, "side_room", "m", positive=True)
+    slab_cells = _integer(slab_cells, "slab_cells", 0, 64)
+    if slab_cells and variant == "filled":         # the 1 m filler box would carry 1 m of mass for an n·l slab
+        raise ValueError(f"slab_cells = {slab_cells}: the 3D slab is built for the variants 'intact' and 'open' only (got 'filled')")
+    T = slab_cells * spacing if slab_cells else 1.0   # thickness [m]: the 2D forces are per metre
+    z = (0.0,) if slab_cells else ()              # the slab's z range: [0, T]
     blocked_dofs(filler_blocked, "filler_blocked")
     from yade import O
     from ..bodies import RigidBodies
     rock = material or rocks.miao2018_sandstone()
     side = side_room                               # grid room beside the free faces for spalled fragments
-    s = make_solver((-side, 0), (W + side, H), spacing, margin=2)
-    add_region(s, rock, (0, 0), (W, H), ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
+    zt = (T,) if slab_cells else ()
+    s = make_solver((-side, 0) + z, (W + side, H) + zt, spacing, margin=2)
+    add_region(s, rock, (0, 0) + z, (W, H) + zt, ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
     s.addBoundaryPlane(1, -1, 0.0, "slip")
+    if slab_cells:                                 # front and back faces: slip (symmetry) planes
+        s.addBoundaryPlane(2, -1, 0.0, "slip")
+        s.addBoundaryPlane(2, 1, T, "slip")
     if end_cap_cells > 0:                          # end caps: ε_D⁰ = 0.99 (Eq. 37) near the base and the platen
         y, e0 = s.view("x1"), s.view("eps0")
         e0[(y < end_cap_cells * spacing) | (y > H - end_cap_cells * spacing)] = 0.99
@@ -95,15 +113,15 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         exclude_nodes_inside(s, flaw["polygon"])
     O.reset()
     if not with_bodies:
-        return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H)
+        return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H, thickness=T)
     rb = RigidBodies(s)
-    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction)
+    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction, d0=platen_d0)
     filler = yade_filler(rb, flaw, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
 
     def axial_stress():
-        return rb.force(platen)[1] / W             # the rock pushes the platen up: compression positive
+        return rb.force(platen)[1] / (W * T)       # the rock pushes the platen up: compression positive
 
     def axial_strain():
         return (y0 - O.bodies[platen].state.pos[1]) / H
@@ -114,5 +132,5 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
         O.run(n, True)
     if ramp_time > 0:
         O.bodies[platen].state.vel = (0, 0, 0)     # at rest until the first advance()
-    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H,
+    return s, dict(platen=platen, filler=filler, rigid=rb, engine=eng, flaw=flaw, width=W, height=H, thickness=T,
                    axial_stress=axial_stress, axial_strain=axial_strain, advance=advance)
