@@ -24,7 +24,7 @@ from .materials import ElasticMat, DpGkMat
 from .fields import get, fields, FIELDS, id_order, views, SYM_NAMES
 from .scene import (check_setting, setting_default, courant_option, check_courant, make_solver, add_region, set_initial_stress, boundary_particles, apply_traction,
                     apply_face_traction, consistent_row_weights)
-from .geometry import Circle, Box, Polygon, rotated_rectangle, fill_region
+from .geometry import Circle, Box, Disc, Polygon, rotated_rectangle, fill_region
 from .engine import MpmEngine, engine
 from ._core import ContactParams
 from .bodies import RigidBodies, contact_params
@@ -35,6 +35,6 @@ from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
            "check_setting", "setting_default", "courant_option", "check_courant", "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
-           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "ContactParams", "contact_params", "DemSpheres",
+           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Disc", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "ContactParams", "contact_params", "DemSpheres",
            "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
            "dpgkThresholdScale"]

@@ -116,6 +116,30 @@ class Polygon:
         return float(np.min(proj.max(axis=0) - proj.min(axis=0)))
 
 
+class Disc:
+    """3D thin disc (a penny-shaped flaw): the points within `radius` [m] of the axis through `center` [m]
+    along the unit `normal` and within `thickness`/2 [m] of the mid-plane."""
+    dims = (3,)
+
+    def __init__(self, center, normal, radius, thickness):
+        self.center = _point(center, "Disc center", dims=(3,))
+        n = _point(normal, "Disc normal", dims=(3,))
+        if not np.linalg.norm(n) > 0:
+            raise ValueError(f"Disc normal = {tuple(n)} must be a non-zero vector")
+        self.normal = n / np.linalg.norm(n)
+        self.radius = _number(radius, "Disc radius", "m", positive=True)
+        self.thickness = _number(thickness, "Disc thickness", "m", positive=True)
+
+    def contains(self, x):
+        r = np.asarray(x, float) - self.center
+        h = r @ self.normal
+        return (np.abs(h) <= self.thickness / 2) & (np.sum(r * r, axis=1) - h * h < self.radius ** 2)
+
+    def width(self):
+        """Narrowest extent [m]: the thickness."""
+        return self.thickness
+
+
 def rotated_rectangle(center, length, width, angle):
     """Polygon of a rectangle (a flaw) of given length/width [m] rotated by angle [rad] from x."""
     center = _point(center, "rotated_rectangle center", dims=(2,))
