@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import cases, output, runner
+from yade_mpm import cases, output, rocks, runner
 from yade_mpm.cases import slab_compare, uniaxial_results as results
 
 DEFAULT_SPACING = 2.0e-3      # the 2D study's default grid [m] (scripts/uniaxial_flaw.py)
@@ -32,6 +32,8 @@ def parse(argv=None):
     p.add_argument("--spacing", type=float, default=DEFAULT_SPACING, help="grid spacing [m] (default %(default)s)")
     p.add_argument("--slab-cells", type=int, default=cases.UNIAXIAL_SLAB_CELLS, help="slab thickness [cells] (default %(default)s)")
     p.add_argument("--variant", default="open", choices=("open", "intact"), help="flaw (default %(default)s)")
+    p.add_argument("--threshold-volume", default=None, choices=("particle", "cube", "cell"),
+                   help="V of Eq. 37 for both runs (default: the rock's, 'particle': 2D area × 1 m against 3D dp³, doc/three_d.md)")
     p.add_argument("--only", choices=("2d", "3d"), default=None, help="run one of the two (the other is read from OUT)")
     p.add_argument("--end-time", type=float, default=END_TIME, help="loading time cap [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=60.0, help="wall seconds between progress lines")
@@ -51,7 +53,8 @@ def one_run(a, slab_cells):
     tag = "3d" if slab_cells else "2d"
     d = os.path.join(a.out, tag)
     os.makedirs(d, exist_ok=True)
-    s, sc = cases.uniaxial_flaw(a.variant, a.spacing, slab_cells=slab_cells, label=f"mpm_{tag}")
+    rock = rocks.miao2018_sandstone(**({"thresholdVolume": a.threshold_volume} if a.threshold_volume else {}))
+    s, sc = cases.uniaxial_flaw(a.variant, a.spacing, slab_cells=slab_cells, label=f"mpm_{tag}", material=rock)
     s.courant = a.courant
     curve, snaps = [], {}
 
@@ -74,7 +77,8 @@ def one_run(a, slab_cells):
     output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"], np.column_stack([t, eps, sig / 1e6]))
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
     k, E = results.peak_and_modulus(eps, sig)
-    entry = dict(dim=3 if slab_cells else 2, slab_cells=slab_cells, variant=a.variant, spacing_m=a.spacing, courant=a.courant,
+    entry = dict(dim=3 if slab_cells else 2, slab_cells=slab_cells, variant=a.variant, threshold_volume=str(rock.thresholdVolume),
+                 eps0_median=float(np.median(s.view("eps0"))), spacing_m=a.spacing, courant=a.courant,
                  particles=int(s.numParticles), steps=int(s.steps), wall_time_s=wall, end_reason=res.reason,
                  particle_steps_per_s=s.numParticles * s.steps / wall, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
