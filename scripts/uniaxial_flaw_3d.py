@@ -131,13 +131,15 @@ def figures(out, r2, r3, cmp):
     fig.tight_layout()
     fig.savefig(os.path.join(out, "curves.png"), dpi=120)
     plt.close(fig)
-    keys = sorted(set(r2[3].files) & set(r3[3].files), key=float)[-3:]
+    t3 = np.array(sorted(map(float, r3[3].files)))
+    k3 = {float(k): k for k in r3[3].files}
+    keys = [(k, k3[t3[np.argmin(np.abs(t3 - float(k)))]]) for k in sorted(r2[3].files, key=float) if float(k) <= t3.max() * 1.001][-3:]
     if not keys:
         return
     fig, axs = plt.subplots(1, 2 * len(keys), figsize=(2.4 * 2 * len(keys), 6.5), sharey=True)
     zmid = r3[0]["thickness_m"] / 2
-    for j, key in enumerate(keys):
-        a2, a3 = r2[3][key], r3[3][key]
+    for j, (key, key3) in enumerate(keys):
+        a2, a3 = r2[3][key], r3[3][key3]
         a3 = a3[np.abs(a3[:, 2] - zmid) < r3[0]["spacing_m"] / 2]     # the two particle layers next to the mid-plane
         for ax, a, lab, col in ((axs[2 * j], a2, "2D", 2), (axs[2 * j + 1], a3, "3D mid", 3)):
             ax.scatter(a[:, 0] * 1e3, a[:, 1] * 1e3, c=a[:, col], s=1.2, cmap="inferno_r", vmin=0, vmax=1)

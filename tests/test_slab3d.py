@@ -6,7 +6,7 @@ strain exactly); with the default d0 (half the current particle edge, ½V^(1/D),
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm import cases
+from yade_mpm import cases, rocks
 from yade_mpm.cases import slab_compare
 
 pytest.importorskip("yade")
@@ -50,7 +50,8 @@ def test_slab_modulus_and_curve_within_two_percent():
     # the slope of the second half of the run (the first wave transits are over) is the plane-strain
     # modulus of a uniaxial in-plane stress, E/(1 − ν²) (Miao sandstone), in 2D and in the slab
     late = [np.polyfit(c[0, steps // 2:], c[1, steps // 2:], 1)[0] for c in (c2, c3)]
-    assert late[0] == pytest.approx(9.87e9 / (1 - 0.22 ** 2), rel=0.05)
+    rock = rocks.miao2018_sandstone()
+    assert late[0] == pytest.approx(rock.young / (1 - rock.poisson ** 2), rel=0.05)
     assert late[1] == pytest.approx(late[0], rel=0.02)
 
 
