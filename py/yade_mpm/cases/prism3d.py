@@ -114,7 +114,7 @@ def damage_onset(x, damage, flaw, threshold):
 def rim_profile(x, damage, flaw, spacing, bins=12, cut=0.99):
     """How damage wraps around the rim: for each of `bins` azimuth sectors (φ from −180° to 180°) the share
     of the particles in the ring a ≤ ρ ≤ a + 2l (|h| ≤ 3l) with D ≥ cut, and the largest distance |h| [m] from
-    the disc plane reached by D ≥ cut particles with ρ ≥ a − l in the sector (the wing crack's reach).
+    the disc plane reached by D ≥ cut particles with a − l ≤ ρ ≤ 2a and |h| ≤ 2a in the sector (the wing crack's reach).
     Returns a list of dicts (phi_lo_deg, phi_hi_deg, ring_share, wing_reach_m)."""
     rho, phi, h = disc_coordinates(x, flaw)
     a, d = flaw["radius"], np.asarray(damage) >= cut
@@ -123,7 +123,7 @@ def rim_profile(x, damage, flaw, spacing, bins=12, cut=0.99):
     for lo, hi in zip(edges[:-1], edges[1:]):
         sec = (phi >= lo) & (phi < hi)
         ring = sec & (rho >= a) & (rho <= a + 2 * spacing) & (np.abs(h) <= 3 * spacing)
-        wing = sec & d & (rho >= a - spacing)
+        wing = sec & d & (rho >= a - spacing) & (rho <= 2 * a) & (np.abs(h) <= 2 * a)
         out.append(dict(phi_lo_deg=float(lo), phi_hi_deg=float(hi), ring_share=float(d[ring].mean()) if ring.any() else float("nan"),
                         wing_reach_m=float(np.abs(h[wing]).max()) if wing.any() else 0.0))
     return out
