@@ -62,11 +62,67 @@ public:
 		keep(P, go);
 		settle(g);
 	}
-	// Before the counting sort: the first call splits the (replicated) scene, later calls migrate.
-	void migrate(const Grid<D>& g, Particles<D>& P)
+	// Before the counting sort: the first call splits the (replicated) scene, later calls re-balance (when the
+	// busiest rank holds more than `threshold` × the mean particle count) and migrate.
+	void migrate(const Grid<D>& g, Particles<D>& P, Real threshold)
 	{
 		if (!distributed()) return;
 		if (!decomposed) return split(g, P);
+		if (!rebalance(g, P, threshold)) {
+			hop(g, P, true);
+			return;
+		}
+		// After a re-cut a particle may belong to a rank several slabs away: it hops one neighbour per pass
+		// (≤ R − 1 passes; every rank takes part in every pass, so none waits in a collective).
+		for (int pass = 0; pass < R - 1; ++pass)
+			if (!hop(g, P, false)) break;
+	}
+	size_t rebalances = 0;     // re-cuts of the slabs since the split
+	Real   imbalance  = 1;     // max / mean of the per-rank particle counts at the last re-sort (after any re-cut)
+
+	// Dynamic load balance (doc/scaling.md), at every re-sort: the particle counts per block layer are summed
+	// over the ranks (integers in doubles: exact, the same on every rank; one MPI_Allreduce of a few dozen
+	// doubles); when max/mean of the per-rank counts exceeds the threshold (inf: never), the slabs are cut
+	// again by the start rule (SlabLayout::balanced). A new cut that would put a
+	// symmetry plane across a slab boundary is not taken (the same answer on every rank). True if re-cut.
+	bool rebalance(const Grid<D>& g, const Particles<D>& P, Real threshold)
+	{
+		const int           L = SlabLayout<D>::layers(g);
+		std::vector<double> count(size_t(L), 0.0);
+		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
+		Comm::sum(count.data(), L);
+		imbalance = imbalanceOf(layout, count);
+		if (!(imbalance > threshold)) return false;
+		SlabLayout<D> cut = SlabLayout<D>::balanced(count, R);
+		if (cut.first == layout.first) return false;
+		try {
+			cut.checkMirrors(g);
+		} catch (const InputError&) {
+			return false;
+		}
+		layout = cut;
+		settle(g);
+		imbalance = imbalanceOf(layout, count);
+		++rebalances;
+		return true;
+	}
+	// max / mean of the per-rank particle counts of a layout (1 for no particles).
+	Real imbalanceOf(const SlabLayout<D>& s, const std::vector<double>& count) const
+	{
+		double total = 0, most = 0;
+		for (int r = 0; r < R; ++r) {
+			double n = 0;
+			for (int c = s.first[size_t(r)]; c < s.first[size_t(r) + 1]; ++c) n += count[size_t(c)];
+			total += n, most = std::max(most, n);
+		}
+		return total > 0 ? most * R / total : 1;
+	}
+
+	// One migration pass: particles whose block layer belongs to another rank move one rank towards it.
+	// strict: a particle must not be more than one slab away (no re-cut since the last re-sort). Returns
+	// whether any particle on any rank moved.
+	bool hop(const Grid<D>& g, Particles<D>& P, bool strict)
+	{
 		std::vector<uint8_t> go(P.n, 0); // 0: stays, 1: to rank − 1, 2: to rank + 1
 		bool                 ok = true;
 		size_t               nd = 0, nu = 0;
@@ -77,7 +133,8 @@ public:
 			go[p] = o < rank ? 1 : 2;
 			(o < rank ? nd : nu) += 1;
 		}
-		if (!Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
+		if (strict && !Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
+		if (!strict && Comm::all(nd + nu == 0)) return false;
 		const size_t nf = fieldCount(P);
 		std::vector<double> sd, su, rd(1), ru(1), cd { double(nd) }, cu { double(nu) };
 		Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
@@ -90,6 +147,7 @@ public:
 		keep(P, go);
 		unpack(P, rd, ad, nf), unpack(P, ru, au, nf); // arrivals from below, then from above: a fixed order
 		migrated += nd + nu;
+		return true;
 	}
 
 	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.

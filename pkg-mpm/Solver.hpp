@@ -146,7 +146,7 @@ public:
 		MPM_IF_MPI(dd.checkStep(liveViews);)
 		double t0 = omp_get_wtime();
 		if (needSort || (steps % sortPeriod) == 0 MPM_IF_MPI(|| dd.needsSplit())) {
-			MPM_IF_MPI(dd.migrate(grid, P);) // particles that left the rank's slab go to its neighbour
+			MPM_IF_MPI(dd.migrate(grid, P, mpiRebalance);) // re-balance; particles that left the rank's slab go to its owner
 			sched.sort(grid, P), needSort = false;
 		}
 		errP2G.clear(), errContact.clear(), errG2P.clear();

@@ -14,6 +14,8 @@
 	X(Real, tractionRampTime, 0, "s", 0, INFINITY, CO, "", "particle surface forces ramp linearly from 0 over this time; 0 = at once", \
 	  "Eq. 22", "")                                                                                                              \
 	X(int, sortPeriod, 50, "steps", 1, 1e9, CC, "", "re-sort particles by block at least every this many steps", "", "")        \
+	X(Real, mpiRebalance, 1.1, "-", 1, INFINITY, CC, "", "MPI only: at each re-sort, cut the slabs again when the busiest rank holds more " \
+	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")
 
 #define MPM_SOLVER_PARAMS(X) MPM_SOLVER_SETTINGS(X) MPM_SOLVER_STATE(X)

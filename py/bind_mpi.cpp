@@ -24,6 +24,8 @@ bp::dict mpiInfo(Solver<D>& s)
 	d["firstLayers"]   = first; // block layers (8 cells) along the last axis owned by rank r: [first[r], first[r+1])
 	d["particles"]     = s.P.n;  // on this rank
 	d["migrated"]      = s.dd.migrated;
+	d["rebalances"]    = s.dd.rebalances; // re-cuts of the slabs (Solver.mpiRebalance)
+	d["imbalance"]     = s.dd.imbalance;  // max/mean of the per-rank particle counts at the last re-sort (after any re-cut)
 	d["haloBytesSent"] = s.dd.halo.bytesLastStep; // per shared-node exchange (two per step)
 	return d;
 }
@@ -71,7 +73,7 @@ void initMpi()
 template <int D>
 void exposeMpi(SolverClass<D>& cls, const char*)
 {
-	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, haloBytesSent.");
+	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, rebalances, imbalance, haloBytesSent.");
 	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, "Checkpoint resume: the saved slab layout and the rank's particle count (yade_mpm.checkpoint).");
 }
 template void exposeMpi<2>(SolverClass<2>&, const char*);

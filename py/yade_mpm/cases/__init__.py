@@ -22,7 +22,7 @@ tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies), tunnel_results, uni
 (imported by name: ``from yade_mpm.cases import tunnel_results``). Quantities are SI; stresses are tension positive inside the solver.
 """
 from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING_SXX, OPENING_SYY, apply_far_field,
-                      circular_opening, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
+                      circular_opening, drifting_block, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
 from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler,
                       yade_platen)
 from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_TOE_HEIGHT,

@@ -145,3 +145,19 @@ def mode_period(solver, shape, t_end):
         raise ValueError(f"t_end = {t_end} s holds fewer than two downward zero crossings of the mode")
     tz = t[k] + (t[k + 1] - t[k]) * q[k] / (q[k] - q[k + 1])
     return float(np.mean(np.diff(tz)))
+
+
+def drifting_block(spacing=0.01, speed=35.0, rebalance=1.1):
+    """A 0.1 × 0.24 m soft elastic block (E = 2 MPa, ν = 0.25, ρ = 2000 kg/m³: c_p ≈ 37 m/s) drifting up a
+    0.64 m tall empty grid at `speed` [m/s] with a little shear (±1 m/s along y, ±0.5 m/s along x): the
+    material leaves the MPI slabs it started in (the load-balance scene of doc/scaling.md). `rebalance`
+    is Solver.mpiRebalance (inf: never re-cut). Returns the solver."""
+    s = make_solver((-0.03, 0.0), (0.13, 0.64), spacing, margin=2)
+    add_region(s, ElasticMat(young=2e6, poisson=0.25, density=2000.0), (0.0, 0.0), (0.1, 0.24))
+    s.sortPeriod = 10
+    s.mpiRebalance = rebalance
+    x0, x1 = np.array(s.view("x0")), np.array(s.view("x1"))
+    s.view("v1")[:] = speed + np.sin(np.pi * x0 / 0.1)
+    s.view("v0")[:] = 0.5 * np.cos(np.pi * x1 / 0.24)
+    s.requestSort()
+    return s
