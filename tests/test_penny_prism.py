@@ -55,3 +55,5 @@ def test_penny_prism_bad_input():
         prism3d.penny_prism("penny", 0.005)
     with pytest.raises(ValueError, match="variant"):
         prism3d.penny_prism("filled", 0.004)
+    with pytest.raises(ValueError, match="flaw_nodes"):
+        prism3d.penny_prism("penny", 0.004, flaw_nodes="none")

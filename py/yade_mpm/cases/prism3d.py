@@ -31,12 +31,14 @@ def penny_flaw(size=PRISM_SIZE, flaw=UNIAXIAL_FLAW, specimen_width=UNIAXIAL_WIDT
 
 
 def penny_prism(variant, spacing, symmetry="none", ppc=2, material=None, platen_speed=PLATEN_SPEED, label="mpm",
-                size=PRISM_SIZE, side_room=PRISM_SIDE_ROOM):
+                size=PRISM_SIZE, side_room=PRISM_SIDE_ROOM, flaw_nodes="excluded"):
     """The prism [0, W] × [0, H] × [0, D] (size) of ``rocks.miao2018_sandstone()`` (or `material`) on a
     free-slip base y = 0, loaded by the rigid frictionless YADE platen of ``uniaxial_flaw`` (moving down at
     `platen_speed` [m/s]); variant "penny": the disc flaw of ``penny_flaw`` cut out (an open flaw: its nodes
     excluded from the fits), "intact": none. symmetry: "none" (the whole prism), "z" (the half z ≥ D/2 with
     a slip plane on z = D/2: the disc's plane of symmetry), "xz" (intact only: the quarter x ≥ W/2, z ≥ D/2).
+    flaw_nodes: "excluded" (default: the grid nodes inside the disc out of the fits, as the 2D open flaw) or "shared"
+    (only the particles removed; the paper's construction, ``add_region(gap_nodes="shared")``).
     Returns (solver, scene) with scene = dict(platen, rigid, engine, flaw (penny_flaw dict or None), size,
     modelled (the modelled part's lo, hi), axial_stress() [Pa, compression positive: the platen reaction over
     the modelled cross-section], axial_strain() [-])."""
@@ -45,6 +47,8 @@ def penny_prism(variant, spacing, symmetry="none", ppc=2, material=None, platen_
     if symmetry not in PRISM_SYMMETRY or (symmetry == "xz" and variant != "intact"):
         raise ValueError(f"symmetry = {symmetry!r} must be one of {PRISM_SYMMETRY} ('xz' only for 'intact': the inclined disc "
                          "is not symmetric about x = W/2)")
+    if flaw_nodes not in ("excluded", "shared"):
+        raise ValueError(f"flaw_nodes = {flaw_nodes!r} must be 'excluded' or 'shared'")
     spacing = _number(spacing, "spacing", "m", positive=True)
     W, H, D = size
     flaw = penny_flaw(size) if variant == "penny" else None
@@ -63,13 +67,13 @@ def penny_prism(variant, spacing, symmetry="none", ppc=2, material=None, platen_
     room = np.array([1.0, 0.0, 1.0]) * np.ceil(_number(side_room, "side_room", "m", positive=True) / spacing - 1e-9) * spacing
     # whole cells of room: the prism's faces (and the symmetry planes) stay on node lines
     s = make_solver(lo - room * (lo == 0), hi + room, spacing, margin=2)
-    add_region(s, rock, lo, hi, ppc=ppc, holes=[flaw["disc"]] if flaw else [])
+    add_region(s, rock, lo, hi, ppc=ppc, holes=[flaw["disc"]] if flaw else [], gap_nodes=flaw_nodes)
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     if symmetry != "none":
         s.addBoundaryPlane(2, -1, D / 2, "slip")
     if symmetry == "xz":
         s.addBoundaryPlane(0, -1, W / 2, "slip")
-    if flaw:
+    if flaw and flaw_nodes == "excluded":
         exclude_nodes_inside(s, flaw["disc"])
     O.reset()
     rb = RigidBodies(s)
