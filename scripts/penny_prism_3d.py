@@ -62,12 +62,8 @@ def one_run(a, variant, symmetry):
                 onset[lev] = dict(time_s=solver.time, axial_stress_MPa=curve[-1][2] / 1e6, axial_strain=curve[-1][1],
                                   particles=len(first), nearest=first[:6])
 
-    def snapshot(solver):
-        f = ym.fields(solver, ["pos", "damage", "plastic_strain"])
-        snaps[f"{solver.time:.6e}"] = np.column_stack([f["pos"], f["damage"], f["plastic_strain"]]).astype(np.float32)
-
-    def softened(solver):
-        return solver.steps % 50 == 0 and results.softened(curve, solver.time)
+    snapshot = results.field_snapshots(snaps, dtype=np.float32)
+    softened = results.stop_when_softened(curve)
     series = output.VtuSeries(d)
     t0 = time.time()
     res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
@@ -170,9 +166,7 @@ def summarize(out):
     ax.set_ylabel("axial stress [MPa]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "curves.png"), dpi=120)
-    plt.close(fig)
+    output.save_figure(fig, os.path.join(out, "curves.png"), dpi=120)
     peaks = {e["variant"]: e["peak_stress_MPa"] for e in runs}
     summary = dict(runs=[{k: v for k, v in e.items() if k != "dir"} for e in runs])
     if "penny" in peaks and "intact" in peaks:

@@ -100,12 +100,8 @@ def one_run(variant, mu, c_mpa, a):
     def record(solver):
         curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
 
-    def snapshot(solver):
-        f = ym.fields(solver, ["pos", "damage", "plastic_strain", "max_principal_stress"])
-        snaps[f"{solver.time:.6e}"] = np.column_stack([f["pos"], f["damage"], f["plastic_strain"], f["max_principal_stress"]])
-
-    def softened(solver):       # stop after the peak (checked every 50 steps)
-        return solver.steps % 50 == 0 and results.softened(curve, solver.time)
+    snapshot = results.field_snapshots(snaps, ("pos", "damage", "plastic_strain", "max_principal_stress"))
+    softened = results.stop_when_softened(curve)       # stop after the peak (checked every 50 steps)
     series = output.VtuSeries(d)
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
     snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})

@@ -61,12 +61,8 @@ def one_run(a, slab_cells):
     def record(solver):
         curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
 
-    def snapshot(solver):
-        f = ym.fields(solver, ["pos", "damage", "plastic_strain"])
-        snaps[f"{solver.time:.6e}"] = np.column_stack([f["pos"], f["damage"], f["plastic_strain"]]).astype(np.float32)
-
-    def softened(solver):
-        return solver.steps % 50 == 0 and results.softened(curve, solver.time)
+    snapshot = results.field_snapshots(snaps, dtype=np.float32)
+    softened = results.stop_when_softened(curve)
     series = output.VtuSeries(d)
     t0 = time.time()
     res = runner.run(s, end_time=a.end_time, progress=a.progress, label=tag, advance=O.step, stop=softened,
@@ -128,9 +124,7 @@ def figures(out, r2, r3, cmp):
     ax[1].grid(alpha=0.3)
     fig.suptitle(f"uniaxial {r2[0]['variant']} flaw, l = {r2[0]['spacing_m'] * 1e3:g} mm: E 2D {cmp['E_2d'] / 1e9:.3f}, "
                  f"3D {cmp['E_3d'] / 1e9:.3f} GPa; peak 2D {cmp['peak_2d'] / 1e6:.1f}, 3D {cmp['peak_3d'] / 1e6:.1f} MPa", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "curves.png"), dpi=120)
-    plt.close(fig)
+    output.save_figure(fig, os.path.join(out, "curves.png"), dpi=120)
     t3 = np.array(sorted(map(float, r3[3].files)))
     k3 = {float(k): k for k in r3[3].files}
     keys = [(k, k3[t3[np.argmin(np.abs(t3 - float(k)))]]) for k in sorted(r2[3].files, key=float) if float(k) <= t3.max() * 1.001][-3:]
@@ -147,9 +141,7 @@ def figures(out, r2, r3, cmp):
             ax.set_title(f"{lab} D, t = {float(key) * 1e3:.1f} ms", fontsize=8)
             ax.set_xlabel("x [mm]")
     axs[0].set_ylabel("y [mm]")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "damage.png"), dpi=110)
-    plt.close(fig)
+    output.save_figure(fig, os.path.join(out, "damage.png"), dpi=110)
 
 
 def main(argv=None):

@@ -34,6 +34,20 @@ def softened(curve, time):
     return st[k] > 5e6 and st[-1] < 0.6 * st[k] and time > 1.2 * curve[k][0]
 
 
+def stop_when_softened(curve):
+    """A runner stop test: `softened` checked every 50 steps on the growing curve [(t, ε, σ)]."""
+    return lambda solver: solver.steps % 50 == 0 and softened(curve, solver.time)
+
+
+def field_snapshots(snaps, names=("pos", "damage", "plastic_strain"), dtype=None):
+    """A runner output that stores the named particle fields, as columns, in snaps["<time>"]."""
+    def snapshot(solver):
+        f = _fields(solver, list(names))
+        a = np.column_stack([f[n] for n in names])
+        snaps[f"{solver.time:.6e}"] = a.astype(dtype) if dtype else a
+    return snapshot
+
+
 def peak_and_modulus(eps, sig):
     """Index of the peak stress and Young's modulus [Pa]: the slope fitted between 10 and 40 % of the
     peak before it (NaN with fewer than 4 such points)."""
