@@ -69,6 +69,10 @@ class DemSpheres:
         with ``add``."""
         if not (isinstance(max_check_steps, numbers.Integral) and not isinstance(max_check_steps, bool) and max_check_steps >= 1):
             raise ValueError(f"max_check_steps = {max_check_steps!r} must be an integer ≥ 1")
+        from .parallel import size
+        if size() > 1:   # the broad phase reads this rank's particle box: ranks would disagree on the active bodies (a hang)
+            raise ValueError(f"DemSpheres: {size()} MPI ranks; DEM spheres are not distributed yet (one process only; "
+                             "rigid bodies of yade_mpm.RigidBodies run under MPI, doc/scaling.md)")
         self.solver, self.dim = solver, dim_of(solver)
         self.ids = np.empty(0, np.int64)
         self.parts = np.empty(0, np.int64)
