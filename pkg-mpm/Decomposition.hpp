@@ -87,10 +87,8 @@ public:
 	// symmetry plane across a slab boundary is not taken (the same answer on every rank). True if re-cut.
 	bool rebalance(const Grid<D>& g, const Particles<D>& P, Real threshold)
 	{
-		const int           L = SlabLayout<D>::layers(g);
-		std::vector<double> count(size_t(L), 0.0);
-		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
-		Comm::sum(count.data(), L);
+		std::vector<double> count = layerCounts(g, P);
+		Comm::sum(count.data(), int(count.size()));
 		imbalance = imbalanceOf(layout, count);
 		if (!(imbalance > threshold)) return false;
 		SlabLayout<D> cut = SlabLayout<D>::balanced(count, R);
@@ -207,10 +205,7 @@ private:
 		if (hiv[0] != -lov[0] || hiv[1] != -lov[1] || hiv[2] != -lov[2])
 			throw InputError("MPI: every rank must build the same scene before the first step (the script runs on every rank); the ranks hold "
 			                 "different particles (counts " + fmtNum(-lov[0]) + " to " + fmtNum(hiv[0]) + ")");
-		const int           L = SlabLayout<D>::layers(g);
-		std::vector<double> count(size_t(L), 0.0);
-		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
-		layout = SlabLayout<D>::balanced(count, R);
+		layout = SlabLayout<D>::balanced(layerCounts(g, P), R); // the scene is replicated: local counts are global
 		layout.checkMirrors(g);
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
@@ -224,6 +219,13 @@ private:
 		ownedLo = rank == 0 ? 0 : size_t(layout.first[size_t(rank)] * B + gh) * st;
 		ownedHi = rank + 1 == R ? g.size() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
 		decomposed = true;
+	}
+	// This rank's particle count per block layer along the slab axis (the input of SlabLayout::balanced).
+	static std::vector<double> layerCounts(const Grid<D>& g, const Particles<D>& P)
+	{
+		std::vector<double> count(size_t(SlabLayout<D>::layers(g)), 0.0);
+		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
+		return count;
 	}
 	size_t              ownedLo = 0, ownedHi = 0; // nodes counted by this rank in sums over nodes (ownsNode)
 	std::vector<double> gathered;                 // scratch of sumInRankOrder

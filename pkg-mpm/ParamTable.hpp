@@ -74,12 +74,8 @@ struct ParamInfo {
 	}
 	// "(0, inf)", "[0, 1]", ...
 	std::string rangeText() const { return std::string(loOpen() ? "(" : "[") + num(lo) + ", " + num(hi) + (hiOpen() ? ")" : "]"); }
-	// Finite values only, except an infinite end the range closes on ("[1, inf]": inf means "never").
-	bool inRange(Real v) const
-	{
-		return (std::isfinite(v) || (std::isinf(v) && (v == hi ? !hiOpen() : v == lo && !loOpen()))) && (loOpen() ? v > lo : v >= lo)
-		       && (hiOpen() ? v < hi : v <= hi);
-	}
+	// NaN fails every comparison; ±inf passes only an infinite end the range closes on ("[1, inf]": inf = "never").
+	bool inRange(Real v) const { return (loOpen() ? v > lo : v >= lo) && (hiOpen() ? v < hi : v <= hi); }
 	// Throws InputError naming the parameter, the value, the unit and the allowed range.
 	void check(Real v) const
 	{
