@@ -11,6 +11,7 @@ Folders read (each optional; a missing one is reported with the command that mak
     penny_crack/       scripts/penny_crack.py
     stability/         scripts/stability.py
     uniaxial_flaw/     scripts/uniaxial_flaw.py
+    uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: open and filled μ_con = 0.6)
     tunnel/            scripts/tunnel_spalling.py            (default grid, all four cases)
     tunnel_paper/      scripts/tunnel_spalling.py --paper    (paper grid)
     fidelity_variants/ scripts/fidelity_variants.py          (variant screening; notes.md: how it was run)
@@ -32,7 +33,8 @@ PARTS = {
     "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
-    "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --cases intact",
+    "uniaxial_paper": "OMP_NUM_THREADS=2 /usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs open,filled:0.6:0",
+    "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --threads 2 --cases intact,open_flaw,filled_flaw",
 }
 
 
@@ -211,12 +213,12 @@ def stability(R):
     R.figures("stability", ["energy_ratio.png"])
 
 
-def uniaxial(R):
-    R.w("## Uniaxial compression with a flaw (paper Sec. 3.3)", "")
-    s = R.load("uniaxial_flaw")
+def uniaxial(R, part="uniaxial_flaw", title="Uniaxial compression with a flaw (paper Sec. 3.3)"):
+    R.w(f"## {title}", "")
+    s = R.load(part)
     if s is None:
         return
-    notes = os.path.join(R.folder("uniaxial_flaw"), "notes.md")   # how the runs were made
+    notes = os.path.join(R.folder(part), "notes.md")   # how the runs were made
     if os.path.exists(notes):
         R.w(open(notes).read().rstrip(), "")
     flat = {k: v for k, v in s.items() if isinstance(v, (int, float, str, bool))}
@@ -227,7 +229,7 @@ def uniaxial(R):
             keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None][:8]
             R.w(f"**{k}**", "")
             R.w(*table(v, [(c, (lambda c: lambda r: r.get(c))(c)) for c in keys]))
-    R.figures("uniaxial_flaw", ["curves_mu.png", "curves_c.png", "damage_plastic_open.png", "damage_plastic_filled_mu0.6_c0MPa.png"])
+    R.figures(part, ["curves_mu.png", "curves_c.png", "damage_plastic_open.png", "damage_plastic_filled_mu0.6_c0MPa.png"])
 
 
 # ------------------------------------------------------------------------------------------ tunnel
@@ -325,7 +327,7 @@ def load_tunnel(R, part):
 def fidelity_section(R):
     """The fidelity table: every claim of the paper about its results (yade_mpm.fidelity_table.ROWS), measured."""
     from yade_mpm import fidelity_table
-    parts = {p: R.read(p) for p in ("circular_opening", "penny_crack", "penny_crack_damage", "uniaxial_flaw")}
+    parts = {p: R.read(p) for p in ("circular_opening", "penny_crack", "penny_crack_damage", "uniaxial_flaw", "uniaxial_paper")}
     parts["penny_crack_damage"] = parts["penny_crack_damage"] or parts["penny_crack"]   # one run with --parts elastic,damage
     parts.update(tunnel=load_tunnel(R, "tunnel"), tunnel_paper=load_tunnel(R, "tunnel_paper"))
     rows = fidelity_table.rows(parts)
@@ -484,6 +486,7 @@ def main():
     penny(R)
     stability(R)
     uniaxial(R)
+    uniaxial(R, "uniaxial_paper", "Uniaxial compression with a flaw at the paper's grid (0.5 mm)")
     print(f"wrote {R.write()}")
 
 

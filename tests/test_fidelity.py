@@ -144,6 +144,13 @@ def test_table_rows_from_constructed_summaries():
     rows = fidelity_table.rows(dict(uniaxial_flaw=u, tunnel=t))
     assert len(rows) == len(fidelity_table.ROWS)
     assert all(r["default"] for r in rows) and {r["verdict"] for r in rows if r["part"] == "circular_opening"} == {"not run"}
+    # the paper grid's uniaxial column reads its own runs (open + filled μ_con = 0.6), and says which rows it did not run
+    up = dict(runs=[dict(u["runs"][0], peak_stress_MPa=28.0), dict(u["runs"][1], peak_stress_MPa=31.0)])
+    rows = {(r["fig"], r["claim"]): r for r in fidelity_table.rows(dict(uniaxial_flaw=u, uniaxial_paper=up, tunnel=t))}
+    above = rows[("Fig. 13a", "rigid-filled (μ_con = 0.6) peaks above the open flaw")]
+    assert above["verdict"] == "differs" and above["verdict_paper"] == "agrees" and "31.0 MPa vs open 28.0" in above["paper_grid"]
+    mu = rows[("Fig. 13a", "peak rises with μ_con")]
+    assert mu["verdict_paper"] == "not run" and mu["paper_grid"] == fidelity_table.PAPER_UNIAXIAL_SUBSET
 
 
 def test_von_mises_variant_is_the_named_option_and_the_default_is_the_reference_codes():

@@ -3,6 +3,7 @@ results (Figs. 4–19), each with the measured counterpart from the runs' summar
 default grid and at the paper's grid. ``rows(parts)`` takes the summaries:
 
     parts = dict(circular_opening=summary.json, penny_crack=..., penny_crack_damage=..., uniaxial_flaw=...,
+                 uniaxial_paper=the same at 0.5 mm,
                  tunnel=dict(cases=[...], info={case: case.json}), tunnel_paper=the same at l = 1 mm)
 
 (any may be None) and returns dicts fig, claim, default, paper_grid, verdict, verdict_paper. Verdicts:
@@ -200,6 +201,8 @@ def u_scatter(u):
 PAPER_UNIAXIAL = ("not run: at 0.5 mm the open-flaw scene has 119,200 particles (16× 2 mm's) and 8,460 steps per ms (4×), "
                   "64× the particle-steps; a 0.1 ms probe ran 1.38 M particle-steps/s on one shared thread, so one run to its "
                   "post-peak stop (≈ 75,000 steps) needs ≈ 110 min, over the session's budget")
+PAPER_UNIAXIAL_SUBSET = ("not run at 0.5 mm: the paper grid ran the open flaw and the rigid-filled flaw (μ_con = 0.6) only, "
+                         "not the intact specimen or the μ_con / c_con sweeps")
 PAPER_TUNNEL = ("not run at l = 1 mm with this build; the last 1 mm runs (an earlier build, ε̄p grown by the von Mises "
                 "Δλ/√3 before issue 18) are in doc/paper_grid_and_courant_7ac11e5.md")
 PAPER_BENCH = "benchmarks: the paper's grid is the convergence study's finest point where run"
@@ -245,7 +248,9 @@ def rows(parts):
         if part == "tunnel":
             pm, pv = _measure(fn, parts["tunnel_paper"]) if parts.get("tunnel_paper") else (PAPER_TUNNEL, "not run")
         elif part == "uniaxial_flaw":
-            pm, pv = PAPER_UNIAXIAL, "not run"
+            pm, pv = _measure(fn, parts["uniaxial_paper"]) if parts.get("uniaxial_paper") else (PAPER_UNIAXIAL, "not run")
+            if pv == "not run" and parts.get("uniaxial_paper"):
+                pm = PAPER_UNIAXIAL_SUBSET
         else:
             pm, pv = PAPER_BENCH, "—"
         out.append(dict(fig=fig, claim=claim, default=m, verdict=v, paper_grid=pm, verdict_paper=pv, part=part))
