@@ -14,7 +14,6 @@ import argparse
 import json
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -42,16 +41,12 @@ def parse(argv=None):
 
 
 def one_run(a, variant, symmetry):
-    from yade import O
     name = f"{variant}_{symmetry}"
     d = os.path.join(a.out, name)
     os.makedirs(d, exist_ok=True)
     s, sc = prism3d.penny_prism(variant, a.spacing, symmetry=symmetry, label=f"mpm_{name}")
     fl = sc["flaw"]
-    curve, snaps, onset = [], {}, {}
-
-    def record(solver):
-        curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
+    snaps, onset = {}, {}
 
     def watch(solver):                         # the first particles past each damage level, every 10 steps
         D = ym.get(solver, "damage")
@@ -59,24 +54,16 @@ def one_run(a, variant, symmetry):
             if lev not in onset and D.max() >= lev:
                 x = ym.get(solver, "pos")
                 first = prism3d.damage_onset(x, D, fl, lev) if fl else [dict(pos_m=x[i].tolist()) for i in np.nonzero(D >= lev)[0]]
-                onset[lev] = dict(time_s=solver.time, axial_stress_MPa=curve[-1][2] / 1e6, axial_strain=curve[-1][1],
+                onset[lev] = dict(time_s=solver.time, axial_stress_MPa=sc["axial_stress"]() / 1e6, axial_strain=sc["axial_strain"](),
                                   particles=len(first), nearest=first[:6])
 
-    snapshot = results.field_snapshots(snaps, dtype=np.float32)
-    softened = results.stop_when_softened(curve)
-    series = output.VtuSeries(d)
-    t0 = time.time()
-    res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
-                     outputs=[runner.Output(record, steps=1), runner.Output(watch, steps=10),
-                              runner.Output(snapshot, period=SNAP_EVERY, at_end=True),
-                              runner.Output(series.write, period=2 * SNAP_EVERY, at_end=True)])
-    wall = time.time() - t0
-    t, eps, sig = np.array(curve).T
-    output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"], np.column_stack([t, eps, sig / 1e6]))
+    r = results.compression_run(s, sc, d, a.end_time, a.progress, name, results.field_snapshots(snaps, dtype=np.float32),
+                                dict(period=SNAP_EVERY, at_end=True), dict(period=2 * SNAP_EVERY, at_end=True),
+                                [runner.Output(watch, steps=10)])
+    wall, t, eps, sig, k, E = r["wall_s"], r["t"], r["eps"], r["sig"], r["peak"], r["E"]
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
-    k, E = results.peak_and_modulus(eps, sig)
     entry = dict(variant=variant, symmetry=symmetry, spacing_m=a.spacing, particles=int(s.numParticles), steps=int(s.steps),
-                 wall_time_s=wall, end_reason=res.reason, peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]),
+                 wall_time_s=wall, end_reason=r["result"].reason, peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]),
                  time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9), onset={str(k_): v for k_, v in onset.items()},
                  damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))
     if fl:

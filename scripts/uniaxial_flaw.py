@@ -95,36 +95,24 @@ def one_run(variant, mu, c_mpa, a):
     s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
                                 filler_blocked=a.filler_blocked_dofs)
     s.courant = a.courant
-    curve, snaps = [], {}
-
-    def record(solver):
-        curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
-
+    snaps = {}
     snapshot = results.field_snapshots(snaps, ("pos", "damage", "plastic_strain", "max_principal_stress"))
-    softened = results.stop_when_softened(curve)       # stop after the peak (checked every 50 steps)
-    series = output.VtuSeries(d)
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
     snap_times = sorted(set(SNAP_TIMES) | {k * 0.5e-3 for k in range(1, int(a.end_time / 0.5e-3) + 1)})
     fl = sc["flaw"]                                # crack sequence at the flaw ends (Fig. 11b), every 25 steps
     times = fidelity.CrackTimes(lattice, fl["toe"], fl["tip"], analysis.softening_end(s), 2 * a.spacing) if fl else None
     watch = [runner.Output(times.update, steps=25)] if times else []
-    t0 = time.time()
-    res = runner.run(s, end_time=a.end_time, progress=a.progress, label=name, advance=O.step, stop=softened,
-                     outputs=[runner.Output(record, steps=1), runner.Output(snapshot, times=snap_times),
-                              runner.Output(series.write, period=a.vtu_every, at_end=True)] + watch)
-    wall = time.time() - t0
-    t, eps, sig = np.array(curve).T
-    output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"],
-                     np.column_stack([t, eps, sig / 1e6]))
+    r = results.compression_run(s, sc, d, a.end_time, a.progress, name, snapshot, dict(times=snap_times),
+                                dict(period=a.vtu_every, at_end=True), watch)
+    wall, t, eps, sig, k, E = r["wall_s"], r["t"], r["eps"], r["sig"], r["peak"], r["E"]
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
-    k, E = results.peak_and_modulus(eps, sig)
     # cracks and shear bands at the end (yade_mpm.analysis); σ̃max within 2 particle rows of the flaw (Figs. 14–15)
     end = results.end_analytics(s, lattice, fl, snaps, a.spacing)
     entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
-                 particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=res.reason,
-                 softened=bool(res.reason == "stop"), spacing_m=a.spacing, courant=a.courant,
+                 particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=r["result"].reason,
+                 softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, courant=a.courant,
                  filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],

@@ -13,12 +13,11 @@ import argparse
 import json
 import os
 import sys
-import time
 
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import cases, output, rocks, runner
+from yade_mpm import cases, output, rocks
 from yade_mpm.cases import slab_compare, uniaxial_results as results
 
 DEFAULT_SPACING = 2.0e-3      # the 2D study's default grid [m] (scripts/uniaxial_flaw.py)
@@ -49,33 +48,20 @@ def parse(argv=None):
 
 
 def one_run(a, slab_cells):
-    from yade import O
     tag = "3d" if slab_cells else "2d"
     d = os.path.join(a.out, tag)
     os.makedirs(d, exist_ok=True)
     rock = rocks.miao2018_sandstone(**({"thresholdVolume": a.threshold_volume} if a.threshold_volume else {}))
     s, sc = cases.uniaxial_flaw(a.variant, a.spacing, slab_cells=slab_cells, label=f"mpm_{tag}", material=rock)
     s.courant = a.courant
-    curve, snaps = [], {}
-
-    def record(solver):
-        curve.append((solver.time, sc["axial_strain"](), sc["axial_stress"]()))
-
-    snapshot = results.field_snapshots(snaps, dtype=np.float32)
-    softened = results.stop_when_softened(curve)
-    series = output.VtuSeries(d)
-    t0 = time.time()
-    res = runner.run(s, end_time=a.end_time, progress=a.progress, label=tag, advance=O.step, stop=softened,
-                     outputs=[runner.Output(record, steps=1), runner.Output(snapshot, period=SNAP_EVERY, at_end=True),
-                              runner.Output(series.write, period=SNAP_EVERY, at_end=True)])
-    wall = time.time() - t0
-    t, eps, sig = np.array(curve).T
-    output.write_csv(os.path.join(d, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"], np.column_stack([t, eps, sig / 1e6]))
+    snaps = {}
+    r = results.compression_run(s, sc, d, a.end_time, a.progress, tag, results.field_snapshots(snaps, dtype=np.float32),
+                                dict(period=SNAP_EVERY, at_end=True), dict(period=SNAP_EVERY, at_end=True))
+    wall, t, eps, sig, k, E = r["wall_s"], r["t"], r["eps"], r["sig"], r["peak"], r["E"]
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
-    k, E = results.peak_and_modulus(eps, sig)
     entry = dict(dim=3 if slab_cells else 2, slab_cells=slab_cells, variant=a.variant, threshold_volume=str(rock.thresholdVolume),
                  eps0_median=float(np.median(s.view("eps0"))), spacing_m=a.spacing, courant=a.courant,
-                 particles=int(s.numParticles), steps=int(s.steps), wall_time_s=wall, end_reason=res.reason,
+                 particles=int(s.numParticles), steps=int(s.steps), wall_time_s=wall, end_reason=r["result"].reason,
                  particle_steps_per_s=s.numParticles * s.steps / wall, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  thickness_m=sc["thickness"], damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))

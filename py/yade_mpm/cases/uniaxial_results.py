@@ -48,6 +48,32 @@ def field_snapshots(snaps, names=("pos", "damage", "plastic_strain"), dtype=None
     return snapshot
 
 
+def compression_run(solver, scene, folder, end_time, progress, label, snapshot, snapshot_when, vtu_when, outputs=()):
+    """The loading loop of a compression specimen, written once for the uniaxial scripts (2D, 3D slab, penny prism):
+    the platen's curve (t, ε, σ) after every step, `snapshot` (e.g. field_snapshots) and VTU files into FOLDER when
+    due (`snapshot_when`, `vtu_when`: runner.Output timing, e.g. dict(period=1e-3, at_end=True)), extra runner
+    outputs, a stop after the peak (stop_when_softened). Steps through YADE (O.step: the platen is a YADE body).
+    Writes FOLDER/curve.csv (time_s, axial_strain, axial_stress_MPa). Returns dict(result = runner's, wall_s,
+    t, eps, sig [Pa] arrays, peak = index of the peak, E = Young's modulus [Pa] by peak_and_modulus)."""
+    import time
+    from yade import O
+    from .. import output, runner
+    curve = []
+
+    def record(s):
+        curve.append((s.time, scene["axial_strain"](), scene["axial_stress"]()))
+
+    t0 = time.time()
+    res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
+                     outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
+                              runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs))
+    wall = time.time() - t0
+    t, eps, sig = np.array(curve).T
+    output.write_csv(os.path.join(folder, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"], np.column_stack([t, eps, sig / 1e6]))
+    k, E = peak_and_modulus(eps, sig)
+    return dict(result=res, wall_s=wall, t=t, eps=eps, sig=sig, peak=k, E=E)
+
+
 def peak_and_modulus(eps, sig):
     """Index of the peak stress and Young's modulus [Pa]: the slope fitted between 10 and 40 % of the
     peak before it (NaN with fewer than 4 such points)."""
