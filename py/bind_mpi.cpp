@@ -37,6 +37,17 @@ double sum(double v) // over the ranks (also a barrier): checkpoint agreement an
 	Comm::sum(&v, 1);
 	return v;
 }
+// Element-wise max of a list of floats over the ranks (every rank passes the same length): exact, the same
+// bits on every rank. DemSpheres' broad phase takes the global particle box from it (min as max of −x).
+bp::list maxList(bp::object values)
+{
+	std::vector<double> v(size_t(bp::len(values)));
+	for (size_t k = 0; k < v.size(); ++k) v[k] = bp::extract<double>(values[k]);
+	Comm::max(v.data(), int(v.size()));
+	bp::list out;
+	for (double x : v) out.append(x);
+	return out;
+}
 
 // Checkpoint resume (py/yade_mpm/checkpoint.py): the saved slab layout and the rank's particle count; the
 // particle arrays are cut to n (no NumPy view may be alive), then Python writes the saved values into them.
@@ -68,6 +79,7 @@ void initMpi()
 	bp::def("mpiRank", &rank, "This process's rank in MPI_COMM_WORLD.");
 	bp::def("mpiSize", &size, "Number of MPI ranks.");
 	bp::def("mpiSum", &sum, "Sum of a float over the MPI ranks (every rank must call it: a collective).");
+	bp::def("mpiMax", &maxList, "Element-wise max of a list of floats over the MPI ranks (a collective; the same length on every rank).");
 }
 
 template <int D>

@@ -186,11 +186,6 @@ del v
 s.run(3)
 expect("addParticles after the split", lambda: s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.2])), "after the first step")
 expect("checkpoint saving before the first step", lambda: ym.checkpoint.save("/nonexistent/ck", s1), "save after the first step")
-try:            # DEM spheres are refused under MPI (their broad phase is per rank), on every rank
-    import yade
-    expect("DemSpheres under 2 ranks", lambda: ym.DemSpheres(s), "DEM spheres are not distributed yet")
-except ImportError:
-    pass
 if rank == 1:   # a bad value on one rank only: every rank stops with a ValueError (none waits forever)
     v = s.view("v0"); v[0] = np.nan; del v
 s.requestSort()

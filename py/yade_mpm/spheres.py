@@ -27,6 +27,13 @@ at its current speed and with the gravity acceleration of NewtonIntegrator, to c
 smallest gap — at most ``max_check_steps`` steps later. Between checks a step costs one disabled-flag
 test per far body in C++ and nothing in Python.
 
+MPI (``mpirun``, doc/scaling.md "Rigid bodies"): every rank runs the same YADE scene and takes the same
+broad-phase decisions — the particle box is the box of every rank's particles (one max-reduction of 2d
+doubles per check, ``_core.mpiMax``; a rank without particles takes part) and ``Solver.maxSpeed`` is the
+global one — so the ranks enable the same groups at the same steps and meet in the same collectives of
+the contact step; the reactions read back are summed over the ranks in rank order (the same bits on every
+rank). One process makes no MPI call.
+
 2D (plane strain): a sphere acts through its trace at z = 0, the circle of radius √(R² − z_c²); the MPM
 forces are per metre of thickness, and the force/torque added to ``O.forces`` is that × the body's
 thickness t (default: its z-extent, 2R for a sphere at z = 0; or ``thickness``), the convention of
@@ -70,9 +77,7 @@ class DemSpheres:
         if not (isinstance(max_check_steps, numbers.Integral) and not isinstance(max_check_steps, bool) and max_check_steps >= 1):
             raise ValueError(f"max_check_steps = {max_check_steps!r} must be an integer ≥ 1")
         from .parallel import size
-        if size() > 1:   # the broad phase reads this rank's particle box: ranks would disagree on the active bodies (a hang)
-            raise ValueError(f"DemSpheres: {size()} MPI ranks; DEM spheres are not distributed yet (one process only; "
-                             "rigid bodies of yade_mpm.RigidBodies run under MPI, doc/scaling.md)")
+        self._ranks = size()            # > 1: the particle box of the broad phase is reduced over the ranks
         self.solver, self.dim = solver, dim_of(solver)
         self.ids = np.empty(0, np.int64)
         self.parts = np.empty(0, np.int64)
@@ -185,6 +190,21 @@ class DemSpheres:
             self._newton = next((e for e in O.engines if type(e).__name__ == "NewtonIntegrator"), False)
         return float(np.linalg.norm(_vec(self._newton.gravity))) if self._newton else 0.0
 
+    def _particle_box(self):
+        """lo, hi (d,) of the MPM particles. Under MPI the box of every rank's particles (one collective of 2d
+        doubles, an exact max): the ranks check at the same steps and take the same decisions from it."""
+        s, d = self.solver, self.dim
+        if s.numParticles:              # this rank's particles (a rank may hold none under MPI)
+            lo = [float(s.view(f"x{a}").min()) for a in range(d)]
+            hi = [float(s.view(f"x{a}").max()) for a in range(d)]
+        else:
+            lo, hi = [math.inf] * d, [-math.inf] * d
+        if self._ranks > 1:
+            from . import _core
+            b = _core.mpiMax([-v for v in lo] + hi)
+            lo, hi = [-v for v in b[:d]], b[d:]
+        return np.array(lo), np.array(hi)
+
     def _broad_phase(self):
         from yade import O
         s, d = self.solver, self.dim
@@ -194,8 +214,7 @@ class DemSpheres:
         bad = ~(np.isfinite(x).all(axis=1) & np.isfinite(v).all(axis=1))
         if bad.any():                                  # a NaN gap would leave the body inactive, silently
             check_state(O.bodies[int(self.ids[np.argmax(bad)])])
-        lo = np.array([s.view(f"x{a}").min() for a in range(d)])
-        hi = np.array([s.view(f"x{a}").max() for a in range(d)])
+        lo, hi = self._particle_box()
         reach = 2.0 * s.spacing
         gap = np.linalg.norm(np.maximum(0.0, np.maximum(lo - x, x - hi)), axis=1) - self.bound - reach
         act = gap <= 0
