@@ -9,6 +9,7 @@ one-at-a-time variants behind it (scripts/fidelity_variants.py).
 Folders read (each optional; a missing one is reported with the command that makes it):
     circular_opening/  scripts/circular_opening.py --convergence
     penny_crack/       scripts/penny_crack.py
+    circular_opening_paper/, penny_crack_paper/   the elastic benchmarks at the paper's grid (0.01 m, 0.02 m)
     stability/         scripts/stability.py
     uniaxial_flaw/     scripts/uniaxial_flaw.py
     uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: open and filled μ_con = 0.6)
@@ -30,6 +31,8 @@ PARTS = {
     "circular_opening": "/usr/bin/python3 scripts/circular_opening.py --out out/circular_opening --convergence",
     "penny_crack": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack",
     "penny_crack_damage": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack_damage --parts damage",
+    "circular_opening_paper": "/usr/bin/python3 scripts/circular_opening.py --out out/circular_opening_paper --spacing 0.01 --no-convergence --no-vtu",
+    "penny_crack_paper": "/usr/bin/python3 scripts/penny_crack.py --out out/penny_crack_paper --parts elastic --spacing 0.02",
     "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
@@ -327,7 +330,8 @@ def load_tunnel(R, part):
 def fidelity_section(R):
     """The fidelity table: every claim of the paper about its results (yade_mpm.fidelity_table.ROWS), measured."""
     from yade_mpm import fidelity_table
-    parts = {p: R.read(p) for p in ("circular_opening", "penny_crack", "penny_crack_damage", "uniaxial_flaw", "uniaxial_paper")}
+    parts = {p: R.read(p) for p in ("circular_opening", "penny_crack", "penny_crack_damage", "uniaxial_flaw", "uniaxial_paper",
+                                     "circular_opening_paper", "penny_crack_paper")}
     parts["penny_crack_damage"] = parts["penny_crack_damage"] or parts["penny_crack"]   # one run with --parts elastic,damage
     parts.update(tunnel=load_tunnel(R, "tunnel"), tunnel_paper=load_tunnel(R, "tunnel_paper"))
     rows = fidelity_table.rows(parts)

@@ -151,6 +151,13 @@ def test_table_rows_from_constructed_summaries():
     assert above["verdict"] == "differs" and above["verdict_paper"] == "agrees" and "31.0 MPa vs open 28.0" in above["paper_grid"]
     mu = rows[("Fig. 13a", "peak rises with μ_con")]
     assert mu["verdict_paper"] == "not run" and mu["paper_grid"] == fidelity_table.PAPER_UNIAXIAL_SUBSET
+    # a benchmark's paper-grid column: its own run at the paper's spacing (Kirsch 0.01 m), not the default grid's
+    k = dict(l2_rel_error_max=0.004, grid_spacing_m=0.04)
+    r = {x["fig"]: x for x in fidelity_table.rows(dict(circular_opening=k))}["Fig. 4"]
+    assert r["verdict"] == "agrees" and r["verdict_paper"] == "not run" and "l = 0.01 m" in r["paper_grid"]
+    r = {x["fig"]: x for x in fidelity_table.rows(dict(circular_opening=k, circular_opening_paper=dict(k, grid_spacing_m=0.01,
+                                                                                                     l2_rel_error_max=0.07)))}["Fig. 4"]
+    assert r["verdict"] == "agrees" and r["verdict_paper"] == "differs" and "l = 0.01 m" in r["paper_grid"]
 
 
 def test_von_mises_variant_is_the_named_option_and_the_default_is_the_reference_codes():
