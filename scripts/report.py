@@ -377,9 +377,12 @@ def variant_matrix(R, folder="fidelity_variants"):
             "2.5 mm) were screened on an older build (before issue 17's contact fix): "
             "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
     if os.path.exists(os.path.join(REPO, "doc", OLD_INCREMENT)):
-        R.w("Variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) on the "
-            "tunnel filled flaw — Eq. 36 as the principal strain, the opening centred, the flaw toe 5 mm from the wall — are kept "
-            f"verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}); not re-run on this build.", "")
+        done = {r["variant"] for r in runs if r["scene"] == "tunnel"}
+        old = [n for v, n in (("principal_strain", "Eq. 36 as the principal strain"), ("floor_52.5mm", "the opening centred"),
+                              ("flaw_gap_5mm", "the flaw toe 5 mm from the wall")) if v not in done]
+        if old:
+            R.w("Tunnel variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) "
+                f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}).", "")
     notes = os.path.join(R.root, folder, "notes.md")
     if os.path.exists(notes):
         R.w(open(notes).read().rstrip(), "")
