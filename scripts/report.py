@@ -373,8 +373,10 @@ def variant_matrix(R, folder="fidelity_variants"):
         return
     runs = [json.load(open(f)) for f in files]
     if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
-        R.w("Variants not in the matrix below (uniaxial growth law, V = dp³, residual cohesion, ε̄p,crit = 0.01, tunnel intact at "
-            "2.5 mm) were screened on an older build (before issue 17's contact fix): "
+        done = {(r["scene"], r["variant"]) for r in runs}
+        old = [n for v, n in (("as_printed_growth", "uniaxial growth law"), ("v_cube", "V = dp³"), ("no_residual_cohesion", "residual cohesion"),
+                              ("soft_strain_0.01", "ε̄p,crit = 0.01")) if ("uniaxial", v) not in done] + ["tunnel intact at 2.5 mm"]
+        R.w(f"Variants not in the matrix below ({', '.join(old)}) were screened on an older build (before issue 17's contact fix): "
             "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
     if os.path.exists(os.path.join(REPO, "doc", OLD_INCREMENT)):
         done = {r["variant"] for r in runs if r["scene"] == "tunnel"}
