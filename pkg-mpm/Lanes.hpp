@@ -123,9 +123,9 @@ struct PackedRow {
 };
 
 // Interior gather of a packed nodal vector field u: u_p = Σ w_i u_i and ∇u_p = Σ u_i ⊗ ∇ψ_i with
-// ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7).
+// ∇ψ_i = w_i 3/l² (x_i − x_p) (Eqs. 6–7); gradFactor = 3/l² (KernelGeom).
 template <int D>
-inline void gatherPacked(const Grid<D>& g, const std::vector<NodeVec<D>>& field, const Kernel<D>& k, Real (&u)[D], Real (&G)[D][D])
+inline void gatherPacked(const Grid<D>& g, const std::vector<NodeVec<D>>& field, const Kernel<D>& k, Real gradFactor, Real (&u)[D], Real (&G)[D][D])
 {
 	using PR          = PackedRow<D>;
 	constexpr int R   = PR::R;
@@ -149,9 +149,8 @@ inline void gatherPacked(const Grid<D>& g, const std::vector<NodeVec<D>>& field,
 	PR::sumNodes(V, u);
 	PR::sumNodes(GX, gb[0]);
 	for (int b = 0; b < D - 1; ++b) PR::sumNodes(GY[b], gb[b + 1]);
-	const Real Dinv = 3.0 / (g.spacing * g.spacing);
 	for (int a = 0; a < D; ++a)
-		for (int b = 0; b < D; ++b) G[a][b] = Dinv * gb[b][a];
+		for (int b = 0; b < D; ++b) G[a][b] = gradFactor * gb[b][a];
 }
 
 // Interior scatter of an affine nodal vector field into a packed array: node i of the stencil receives

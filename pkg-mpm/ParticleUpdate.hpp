@@ -26,13 +26,14 @@ inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Rea
 	const long    nb     = long(blocks.size()) - 1;
 	Real          rmin   = INFINITY, v2max = 0;
 	int           drift  = 0;
-#pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin) reduction(max : v2max) reduction(| : drift)
+	const KernelGeom<D> geo(tr.grid); // firstprivate: a local of each thread, not reloaded after the particle stores
+#pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin) reduction(max : v2max) reduction(| : drift) firstprivate(geo)
 	for (long b = 0; b < nb; ++b) {
 		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
 			const size_t p = pp;
 			Real L[D][D] = {}, dbar[D];
 			bool cut;
-			if (!tr.velocityGradient(p, L, cut, dbar)) {
+			if (!tr.velocityGradient(geo, p, L, cut, dbar)) {
 				err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 				continue;
 			}

@@ -57,12 +57,26 @@ struct Kernel {
 	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
 
+// The grid constants a kernel evaluation reads, copied once per pass into a local: the Grid fields are doubles,
+// so after every store to a particle array the compiler would reload them and redo the divisions per particle.
+template <int D>
+struct KernelGeom {
+	Real           origin[D], cells[D]; // [m], physical cells per axis
+	Real           h, invH, gradFactor;  // l [m], 1/l, 3/l² (interior M⁻¹ gradient factor, ∇ψ_i = w_i 3/l² (x_i − x_p))
+	size_t         stride[D];
+	const uint8_t* stencilExcl;
+	explicit KernelGeom(const Grid<D>& g) : h(g.spacing), invH(1.0 / g.spacing), gradFactor(3.0 / (g.spacing * g.spacing)), stencilExcl(g.stencilExcl.data())
+	{
+		for (int a = 0; a < D; ++a) origin[a] = g.origin[a], cells[a] = g.cells[a], stride[a] = g.stride[a];
+	}
+};
+
 // checked: x may lie anywhere (k.inside tells); unchecked (G2P and the stress pass of a step whose P2G
 // accepted every position, which do not move before the step ends): x lies inside the physical grid.
 template <int D, bool checked = true>
-inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Kernel<D>& k)
+inline void computeKernel(const KernelGeom<D>& g, const Real* x, Kernel<D>& k)
 {
-	const Real h = g.spacing, invH = 1.0 / g.spacing;
+	const Real h = g.h, invH = g.invH;
 	size_t     base     = 0;
 	k.inside            = true;
 	for (int a = 0; a < D; ++a) {
@@ -75,7 +89,7 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 		const int  c = int(f); // f ≥ 0: truncation is the floor
 		const Real t = f - c; // in [0,1): distances to the 4 nodes c-1..c+2 are t+1, t, 1-t, 2-t
 		// the 4 weights as cubics in t (Horner, one vector): w0 = (1−t)³/6, w1 = t³/2 − t² + 2/3,
-		// w2 = −t³/2 + t²/2 + t/2 + 1/6, w3 = t³/6; offsets x_i − x_p = (j − 1 − t) l
+		// w2 = −t³/2 + t²/2 + t/2 + 1/6, w3 = t³/6 (Eq. 13); offsets x_i − x_p = (j − 1 − t) l
 		typedef Lane4 L4;
 		const L4 c3 = { -1.0 / 6, 0.5, -0.5, 1.0 / 6 }, c2 = { 0.5, -1.0, 0.5, 0.0 }, c1 = { -0.5, 0.0, 0.5, 0.0 };
 		const L4 c0 = { 1.0 / 6, 2.0 / 3, 1.0 / 6, 0.0 }, jm = { -1.0, 0.0, 1.0, 2.0 };
@@ -84,8 +98,12 @@ inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>& so, const R
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
 	k.base    = base;
-	k.general = g.stencilHasExcluded(base); // one load: ghosts near the grid edge, planes, gaps, contact
-	(void)so;
+	k.general = g.stencilExcl[base] != 0; // one load (Grid::stencilHasExcluded): ghosts near the grid edge, planes, gaps, contact
+}
+template <int D, bool checked = true>
+inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>&, const Real* x, Kernel<D>& k)
+{
+	computeKernel<D, checked>(KernelGeom<D>(g), x, k);
 }
 
 // Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit
@@ -119,15 +137,24 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 
 	// General case: moment matrix over active nodes (Eq. 10), basis p = [1, (x_i − x_p)/l] for conditioning.
 	using MatP = Eigen::Matrix<Real, D + 1, D + 1>;
-	using VecP = Eigen::Matrix<Real, D + 1, 1>;
-	MatP M = MatP::Zero();
-	VecP p[N];
+	// Scalar code: p_n is rebuilt from st.d where needed (a basis vector stored element by element and read back as
+	// one vector by Eigen stalled on store forwarding: a third of fillStencil's samples); an excluded node adds w = 0.
+	auto basis = [&](int n, Real (&pn)[D + 1]) {
+		pn[0] = 1;
+		for (int a = 0; a < D; ++a) pn[a + 1] = st.d[a][Stencil<D>::along(n, a)] * invH;
+	};
+	Real Ms[D + 1][D + 1] = {};
 	for (int n = 0; n < N; ++n) {
-		if (g.excluded[base + so.off[n]]) st.w[n] = 0;
-		p[n][0] = 1;
-		for (int a = 0; a < D; ++a) p[n][a + 1] = st.d[a][Stencil<D>::along(n, a)] * invH;
-		if (st.w[n] != 0) M.noalias() += st.w[n] * p[n] * p[n].transpose();
+		const Real w = g.excluded[base + so.off[n]] ? 0.0 : st.w[n];
+		st.w[n]      = w;
+		Real pn[D + 1];
+		basis(n, pn);
+		for (int i = 0; i <= D; ++i)
+			for (int j = 0; j <= D; ++j) Ms[i][j] += (w * pn[i]) * pn[j]; // Eq. 10; + 0 for an excluded node
 	}
+	MatP M;
+	for (int i = 0; i <= D; ++i)
+		for (int j = 0; j <= D; ++j) M(i, j) = Ms[i][j];
 	// M is SPD when the active nodes span a D-simplex; its smallest scale is ~1e-2 in cell units.
 	Real det = M.determinant();
 	if (!(std::abs(det) > 1e-12)) {
@@ -137,9 +164,14 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 		}
 		return false;
 	}
-	MatP Minv = M.inverse();
-	for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient
-		VecP q    = Minv * p[n];
+	const MatP Minv = M.inverse();
+	for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient: q = M⁻¹ p_n
+		Real pn[D + 1], q[D + 1];
+		basis(n, pn);
+		for (int i = 0; i <= D; ++i) {
+			q[i] = Minv(i, 0) * pn[0];
+			for (int j = 1; j <= D; ++j) q[i] += Minv(i, j) * pn[j];
+		}
 		st.psi[n] = st.w[n] * q[0];
 		for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
 	}
