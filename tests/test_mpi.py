@@ -239,3 +239,18 @@ def test_rank_without_particles(tmp_path):
     speeds = [float(line.split("maxSpeed ")[1]) for line in lines if "particles" in line]
     assert len(speeds) == 2 and speeds[0] == speeds[1] and abs(speeds[0] - 4.0) < 0.1, lines
     assert sum("stepped to 10" in line for line in lines) == 2, lines
+
+
+def run_child(tmp_path, child, name, tag, steps, ranks, timeout):
+    """Write the child script `child` as tmp_path/name and run it with (steps, out) on 1 process or `ranks` MPI ranks
+    (scripts/mpi_run.sh, 1 thread each); subprocess timeout [s] (a hang fails here). Returns each rank's OUT.rank.npz."""
+    script = tmp_path / name
+    script.write_text(child)
+    out = str(tmp_path / tag)
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
+    env.pop("YADE_MPM_MPI", None)
+    cmd = [sys.executable, str(script), str(steps), out] if ranks == 1 else [LAUNCH, str(ranks), "1", str(script), str(steps), out]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    assert r.returncode == 0, (r.stdout[-2000:], r.stderr[-3000:])
+    return [dict(np.load(f"{out}.{k}.npz")) for k in range(ranks)]
+

@@ -5,15 +5,11 @@ and holds a free rigid filler in a vertical slot across the slab boundary (its s
 sums nodes of both ranks). On 2 ranks against 1 process (serial core), 150 steps: the particle fields by id,
 the three bodies' impulses (Σ reaction · Δt) and the filler's motion agree within 1e-10 relative (roundoff: the sums are
 added in another order), and both ranks' YADE scenes hold the same bits."""
-import math
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from test_mpi import LAUNCH, ROOT, _max_rel, _merge, _mpi_available
+from test_mpi import _max_rel, _merge, _mpi_available, run_child
 
 pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
 pytest.importorskip("yade")
@@ -64,15 +60,8 @@ NAMES = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol"]
 
 
 def _run(tmp_path, tag, steps, ranks):
-    script = tmp_path / "contact_child.py"
-    script.write_text(CHILD)
-    out = str(tmp_path / tag)
-    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
-    env.pop("YADE_MPM_MPI", None)
-    cmd = [sys.executable, str(script), str(steps), out] if ranks == 1 else [LAUNCH, str(ranks), "1", str(script), str(steps), out]
-    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
-    assert r.returncode == 0, (r.stdout[-2000:], r.stderr[-3000:])
-    return [dict(np.load(f"{out}.{k}.npz")) for k in range(ranks)]
+    parts = run_child(tmp_path, CHILD, "contact_child.py", tag, steps, ranks, timeout=900)   # a hang fails here
+    return parts
 
 
 def test_bodies_two_ranks_match_one(tmp_path):

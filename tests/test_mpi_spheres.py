@@ -8,14 +8,11 @@ growing rate until it comes within reach) and lands later. 400 steps on 1 proces
 and 3 ranks: particle fields by id, sphere positions, velocities and spins within 1e-12 relative; the
 broad-phase schedule (checks, next check, active flags after every step) and every rank's sphere states
 are the same bits on every rank, and the same schedule as 1 process."""
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from test_mpi import LAUNCH, ROOT, _max_rel, _merge, _mpi_available
+from test_mpi import _max_rel, _merge, _mpi_available, run_child
 
 pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
 pytest.importorskip("yade")
@@ -61,15 +58,7 @@ NAMES = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol"]
 
 
 def _run(tmp_path, tag, steps, ranks):
-    script = tmp_path / "spheres_child.py"
-    script.write_text(CHILD)
-    out = str(tmp_path / tag)
-    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
-    env.pop("YADE_MPM_MPI", None)
-    cmd = [sys.executable, str(script), str(steps), out] if ranks == 1 else [LAUNCH, str(ranks), "1", str(script), str(steps), out]
-    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=180)   # a hang fails here
-    assert r.returncode == 0, (r.stdout[-2000:], r.stderr[-3000:])
-    parts = [dict(np.load(f"{out}.{k}.npz")) for k in range(ranks)]
+    parts = run_child(tmp_path, CHILD, "spheres_child.py", tag, steps, ranks, timeout=180)   # a hang fails here
     assert all(int(p["size"]) == ranks for p in parts)
     return parts
 
