@@ -12,7 +12,7 @@ Folders read (each optional; a missing one is reported with the command that mak
     circular_opening_paper/, penny_crack_paper/   the elastic benchmarks at the paper's grid (0.01 m, 0.02 m)
     stability/         scripts/stability.py
     uniaxial_flaw/     scripts/uniaxial_flaw.py
-    uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: open and filled μ_con = 0.6)
+    uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: intact, open, filled μ_con 0–0.6, c_con 5 and 10 MPa)
     tunnel/            scripts/tunnel_spalling.py            (default grid, all four cases)
     tunnel_paper/      scripts/tunnel_spalling.py --paper    (paper grid)
     fidelity_variants/ scripts/fidelity_variants.py          (variant screening; notes.md: how it was run)
@@ -36,7 +36,7 @@ PARTS = {
     "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
-    "uniaxial_paper": "OMP_NUM_THREADS=2 /usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs open,filled:0.6:0",
+    "uniaxial_paper": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs intact,open,filled:0:0,filled:0.2:0,filled:0.4:0,filled:0.6:0,filled:0:5,filled:0:10",
     "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --threads 2 --cases intact,open_flaw,filled_flaw",
 }
 
