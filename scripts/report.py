@@ -17,6 +17,7 @@ Folders read (each optional; a missing one is reported with the command that mak
     tunnel_paper/      scripts/tunnel_spalling.py --paper    (paper grid)
     fidelity_variants/ scripts/fidelity_variants.py          (variant screening; notes.md: how it was run)
     fidelity_notes.md  how the runs of the fidelity table were made (build, commands, wall times)
+    fidelity_grids.md  the default and the paper grid compared: where they differ, which to trust and why
 """
 import argparse
 import glob
@@ -216,14 +217,18 @@ def stability(R):
     R.figures("stability", ["energy_ratio.png"])
 
 
+def include_notes(R, path):
+    """A notes file of the output folder (how the runs were made, written by whoever ran them), verbatim, if present."""
+    if os.path.exists(path):
+        R.w(open(path).read().rstrip(), "")
+
+
 def uniaxial(R, part="uniaxial_flaw", title="Uniaxial compression with a flaw (paper Sec. 3.3)"):
     R.w(f"## {title}", "")
     s = R.load(part)
     if s is None:
         return
-    notes = os.path.join(R.folder(part), "notes.md")   # how the runs were made
-    if os.path.exists(notes):
-        R.w(open(notes).read().rstrip(), "")
+    include_notes(R, os.path.join(R.folder(part), "notes.md"))
     flat = {k: v for k, v in s.items() if isinstance(v, (int, float, str, bool))}
     if flat:
         R.w(*table([{"k": k, "v": v} for k, v in flat.items()], [("quantity", lambda r: r["k"]), ("value", lambda r: r["v"])]))
@@ -258,9 +263,7 @@ def tunnel(R, part, title, keys_intact=("08ms", "12ms", "20ms"), keys_flaw=("20m
                     ("σ at 2.0 mm", lambda e: at(e, 2.0)), ("symmetry D (8 ms)", lambda e: e["symmetry_damage"]),
                     ("first damage", lambda e: e["first_damage_location"])]))
     d = R.folder(part)
-    notes = os.path.join(d, "notes.md")                      # how the runs were made (written by whoever ran them)
-    if os.path.exists(notes):
-        R.w(open(notes).read().rstrip(), "")
+    include_notes(R, os.path.join(d, "notes.md"))
     R.figure(os.path.join(d, "axial_stress.png"), f"{part}_axial_stress.png", "Axial stress against platen displacement (cf. paper Fig. 17)")
     txt = os.path.join(d, "summary.txt")
     if os.path.exists(txt):
@@ -340,9 +343,7 @@ def fidelity_section(R):
         "below (`yade_mpm.fidelity`, `yade_mpm.fidelity_table`, `yade_mpm.analysis`), not read off a picture. Default grid: "
         "tunnel and uniaxial 2 mm; paper grid: tunnel 1 mm, uniaxial 0.5 mm. Verdicts: agrees / partly / differs / not run / "
         "no reference (the paper gives no number).", "")
-    notes = os.path.join(R.root, "fidelity_notes.md")          # how the runs were made (written by whoever ran them)
-    if os.path.exists(notes):
-        R.w(open(notes).read().rstrip(), "")
+    include_notes(R, os.path.join(R.root, "fidelity_notes.md"))
     R.w("| figure | the paper's claim | measured, default grid | verdict | measured, paper grid | verdict |", "|---|---|---|---|---|---|")
     for r in rows:
         R.w(f"| {r['fig']} | {r['claim']} | {r['default']} | **{r['verdict']}** | {r['paper_grid']} | {r['verdict_paper']} |")
@@ -356,6 +357,7 @@ def fidelity_section(R):
             npg[k] = npg.get(k, 0) + 1
     R.w("", "Default grid: " + ", ".join(f"{v} {k}" for k, v in sorted(n.items())) + f" of {len(rows)} rows."
         + (" Paper grid: " + ", ".join(f"{v} {k}" for k, v in sorted(npg.items())) + f" of the {sum(npg.values())} rows run there." if npg else ""), "")
+    include_notes(R, os.path.join(R.root, "fidelity_grids.md"))
 
 
 OLD_INCREMENT = "fidelity_variants_b86bf5e.md"    # the variant matrix run with Δε̄p = Δλ/√3 (before issue 18's default), kept verbatim
@@ -385,9 +387,7 @@ def variant_matrix(R, folder="fidelity_variants"):
         if old:
             R.w("Tunnel variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) "
                 f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}).", "")
-    notes = os.path.join(R.root, folder, "notes.md")
-    if os.path.exists(notes):
-        R.w(open(notes).read().rstrip(), "")
+    include_notes(R, os.path.join(R.root, folder, "notes.md"))
     from yade_mpm import fidelity
     for scene, case in sorted({(r["scene"], r["case"]) for r in runs}):
         rs = sorted((r for r in runs if (r["scene"], r["case"]) == (scene, case)), key=lambda r: list(fidelity.VARIANTS).index(r["variant"]))
@@ -446,9 +446,7 @@ def courant_section(R, folder="courant"):
         R.w(f"*Not run here* — the scripts of `scripts/regress.py` with `--courant C` into `{shown(d)}/cC/` (see the notes of a run).", "")
         frozen(R)
         return
-    notes = os.path.join(d, "notes.md")
-    if os.path.exists(notes):
-        R.w(open(notes).read().rstrip(), "")
+    include_notes(R, os.path.join(d, "notes.md"))
     R.w(fidelity_courant.markdown(fidelity_courant.collect(runs)), "")
 
 
