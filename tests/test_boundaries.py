@@ -177,3 +177,28 @@ def test_faces_of_a_thin_crack_move_independently_and_closing_does_not_stop_the_
     s.requestSort()
     s.run(5)
     assert s.steps == 5
+
+
+@pytest.mark.parametrize("spacing,thin", [(0.5e-3, False), (1e-3, True), (2e-3, True)])
+def test_open_flaw_exclusion_only_when_thinner_than_the_stencil(spacing, thin):
+    # cases.exclude_nodes_inside (the uniaxial open flaw, the 3D disc): the 2 mm flaw is excluded on the 1 and
+    # 2 mm grids (1–2 cells: its faces would share nodes) and not on the paper's 0.5 mm grid (4 cells: the faces
+    # are apart by themselves). There, nodes excluded inside the flaw left material that enters the gap without
+    # a fit: the 0.5 mm open-flaw run stopped at 5.46 ms with "too few active grid nodes" (a fragment at the
+    # flaw's upper end). Every point inside the flaw must keep a fit that reproduces linear fields.
+    fl = ym.cases.uniaxial_flaw_geometry()
+    c = fl["center"]
+    s = ym.make_solver(tuple(c - 0.02), tuple(c + 0.02), spacing)
+    ym.add_region(s, ym.ElasticMat(**MAT), tuple(c - 0.02), tuple(c + 0.02), holes=[fl["polygon"]])
+    n = ym.cases.exclude_nodes_inside(s, fl["polygon"])
+    assert (n > 0) == thin and (np.count_nonzero(s.excludedNodes() & GAP) >= n)
+    xn = s.nodePositions()
+    rng = np.random.default_rng(2)
+    pts = c + rng.uniform(-0.013, 0.013, size=(6000, 2))
+    pts = pts[fl["polygon"].contains(pts)]
+    assert len(pts) > 100
+    for x in pts:
+        idx, psi, grad, _ = s.shapeFunctions(tuple(x))
+        np.testing.assert_allclose(psi.sum(), 1, atol=1e-10)
+        np.testing.assert_allclose(psi @ xn[idx], x, atol=1e-10)
+        np.testing.assert_allclose(grad.T @ xn[idx], np.eye(2), atol=1e-6)

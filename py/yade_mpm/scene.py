@@ -55,6 +55,13 @@ def check_courant(value, option="--courant"):
 
 
 GAP_NODES = ("excluded", "shared")
+STENCIL_CELLS = 4          # the cubic B-spline support [cells]: a hole at least this wide keeps its faces apart on the grid
+
+
+def is_thin(hole, spacing):
+    """True when `hole` (a geometry shape) is narrower than the cubic B-spline support, STENCIL_CELLS cells of
+    `spacing` [m]: only then can particles on its two faces share grid nodes."""
+    return hole.width() < STENCIL_CELLS * spacing
 
 
 def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="excluded"):
@@ -95,7 +102,7 @@ def thin_gap_nodes(solver, lo, hi, dp, holes):
     from scipy.spatial import cKDTree
     d = dim_of(solver)
     h = solver.spacing
-    thin = [g for g in holes if g.width() < 4 * h]
+    thin = [g for g in holes if is_thin(g, h)]
     if not thin:
         return np.zeros(0, np.int64)
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 
 from .. import rocks
-from ..scene import add_region, make_solver
+from ..scene import add_region, is_thin, make_solver
 from ..geometry import _integer, _number
 from .loading import PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler, yade_platen
 from .tunnel import tunnel_flaw
@@ -29,9 +29,15 @@ def uniaxial_flaw_geometry(width=UNIAXIAL_WIDTH, height=UNIAXIAL_HEIGHT, flaw=UN
 
 
 def exclude_nodes_inside(solver, polygon):
-    """Take the physical grid nodes inside `polygon` out of the WLS fits (user exclusion bit): the
-    faces of an open flaw thinner than the stencil then do not share those nodes — the same nodes a
-    rigid filler of the flaw covers (contact bit). Returns the number of nodes excluded."""
+    """Take the physical grid nodes inside `polygon` out of the WLS fits (user exclusion bit) when the flaw is
+    thinner than the stencil (scene.is_thin: < 4 cells): its faces then do not share those nodes — the same
+    nodes a rigid filler of the flaw covers (contact bit). A flaw at least 4 cells wide (the paper's 2 mm flaw
+    on its 0.5 mm grid) keeps its faces apart by itself and gets no exclusion, the paper's construction: nodes
+    excluded there would leave a particle that enters the gap (a fragment at a flaw end, the closing flaw) with
+    no active node for its fit — the 0.5 mm open-flaw run stopped so at 5.46 ms. Returns the number of nodes
+    excluded."""
+    if not is_thin(polygon, solver.spacing):
+        return 0
     xn = solver.nodePositions()
     lo, hi = np.asarray(solver.origin), np.asarray(solver.origin) + solver.spacing * np.asarray(solver.cells)
     inside = polygon.contains(xn) & np.all((xn > lo + 1e-12) & (xn < hi - 1e-12), axis=1)
@@ -49,7 +55,8 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
     free-slip top), and
       variant "intact"  no flaw,
-              "open"    the 25 × 2 mm flaw inclined 30° at the centre cut out (nodes inside excluded),
+              "open"    the 25 × 2 mm flaw inclined 30° at the centre cut out (nodes inside excluded when the flaw is
+                        under 4 cells wide: exclude_nodes_inside),
               "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
                         contact with μ_con = mu_con [-] and c_con = c_con [Pa].
     filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/contact.md).
