@@ -130,6 +130,16 @@ def test_thin_gap_nodes_are_the_crack_midline_only():
     assert not np.any(s4.excludedNodes() & GAP)
 
 
+def _assert_linear_exact_fits(s, pts, grad_tol):
+    """At every point a non-singular WLS fit that reproduces 1, x and the constant gradient (Eqs. 10–15)."""
+    xn = s.nodePositions()
+    for x in pts:
+        idx, psi, grad, _ = s.shapeFunctions(tuple(x))
+        np.testing.assert_allclose(psi.sum(), 1, atol=1e-10)
+        np.testing.assert_allclose(psi @ xn[idx], x, atol=1e-10)
+        np.testing.assert_allclose(grad.T @ xn[idx], np.eye(2), atol=grad_tol)
+
+
 @pytest.mark.parametrize("width,angle,tied", [(2.0, 0.0, True), (1.5, 0.5, True), (3.0, 0.5, True), (2.0, np.pi / 4, True),
                                               (3.8, 0.0, False)])   # 3.8 cells: the particle rows are 4.5 cells apart
 def test_points_inside_a_thin_gap_keep_a_valid_fit(width, angle, tied):
@@ -140,16 +150,11 @@ def test_points_inside_a_thin_gap_keep_a_valid_fit(width, angle, tied):
     flaw = ym.rotated_rectangle((0.6, 0.6), 0.5, width * h, angle)
     ym.add_region(s, ym.ElasticMat(**MAT), (0, 0), (1.2, 1.2), holes=[flaw])
     assert np.any(s.excludedNodes() & GAP) == tied
-    xn = s.nodePositions()
     rng = np.random.default_rng(1)
     pts = rng.uniform(0.3, 0.9, size=(4000, 2))
     pts = pts[flaw.contains(pts)]
     assert len(pts) > 50
-    for x in pts:
-        idx, psi, grad, _ = s.shapeFunctions(tuple(x))
-        np.testing.assert_allclose(psi.sum(), 1, atol=1e-10)
-        np.testing.assert_allclose(psi @ xn[idx], x, atol=1e-10)
-        np.testing.assert_allclose(grad.T @ xn[idx], np.eye(2), atol=1e-8)
+    _assert_linear_exact_fits(s, pts, grad_tol=1e-8)
 
 
 def test_faces_of_a_thin_crack_move_independently_and_closing_does_not_stop_the_run():
@@ -192,13 +197,8 @@ def test_open_flaw_exclusion_only_when_thinner_than_the_stencil(spacing, thin):
     ym.add_region(s, ym.ElasticMat(**MAT), tuple(c - 0.02), tuple(c + 0.02), holes=[fl["polygon"]])
     n = ym.cases.exclude_nodes_inside(s, fl["polygon"])
     assert (n > 0) == thin and (np.count_nonzero(s.excludedNodes() & GAP) >= n)
-    xn = s.nodePositions()
     rng = np.random.default_rng(2)
     pts = c + rng.uniform(-0.013, 0.013, size=(6000, 2))
     pts = pts[fl["polygon"].contains(pts)]
     assert len(pts) > 100
-    for x in pts:
-        idx, psi, grad, _ = s.shapeFunctions(tuple(x))
-        np.testing.assert_allclose(psi.sum(), 1, atol=1e-10)
-        np.testing.assert_allclose(psi @ xn[idx], x, atol=1e-10)
-        np.testing.assert_allclose(grad.T @ xn[idx], np.eye(2), atol=1e-6)
+    _assert_linear_exact_fits(s, pts, grad_tol=1e-6)
