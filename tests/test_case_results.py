@@ -46,3 +46,22 @@ def test_softened_only_past_a_real_peak():
 def test_run_names():
     assert uniaxial_results.run_name("open", 0.4, 1.0) == "open"
     assert uniaxial_results.run_name("filled", 0.4, 0.0) == "filled_mu0.4_c0MPa"
+
+
+def test_compression_run_keeps_the_curve_when_the_solver_stops_the_run(tmp_path):
+    # A long run that the solver stops (a particle off the grid, a singular fit) must keep what it measured:
+    # curve.csv up to the error, result.reason "error" and the message. Here a particle is moved off the grid
+    # through a view at step 30, which the solver refuses at the next step.
+    import yade_mpm as ym
+    from yade_mpm import cases, runner
+    s, sc = cases.uniaxial_flaw("intact", 0.005, side_room=0.01)
+
+    def spoil(solver):
+        if solver.steps == 30:
+            solver.view("x1")[0] = 10.0
+    r = uniaxial_results.compression_run(s, sc, str(tmp_path), 1e-3, 1e9, "spoilt", lambda solver: None, dict(steps=1000),
+                                         dict(period=1.0), [runner.Output(spoil, steps=1)])
+    assert r["result"].reason == "error" and "outside the grid" in r["result"].error, r["result"].error
+    c = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
+    assert len(c) == 30 and np.all(np.diff(c[:, 0]) > 0) and c[-1, 2] > 0       # every step before the refused one
+    assert len(r["t"]) == 30 and r["peak"] == int(np.argmax(r["sig"]))

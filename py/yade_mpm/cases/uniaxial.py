@@ -16,7 +16,7 @@ UNIAXIAL_FLAW = (0.025, 0.002, math.radians(30.0))   # flaw length, width [m], i
 UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
 UNIAXIAL_VARIANTS = ("intact", "open", "filled")
 UNIAXIAL_MAX_SPACING = UNIAXIAL_WIDTH / 10   # coarsest grid [m]: 10 cells across the specimen (a coarser one ran with 3–5 particles)
-UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face [m]: spalled fragments (measured up to 14 m/s) stay on the grid
+UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face and above the top [m]: spalled fragments (measured up to 14 m/s) stay on the grid
 UNIAXIAL_SLAB_CELLS = 2            # thickness of the 3D slab (slab_cells > 0) in grid cells [-] (doc/three_d.md)
 
 
@@ -65,7 +65,10 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     full speed. end_cap_cells ≥ 0: the particles within this many cells of the base and of the platen get a
     Grady–Kipp activation strain ε_D⁰ = 0.99 (Eq. 37) that tension never reaches — "end caps", so the layer
     under the penalty contact does not crack first (doc/mpm_vs_bonded.md); 0 (default) = none.
-    side_room [m] > 0: grid beyond each free side face (default UNIAXIAL_SIDE_ROOM).
+    side_room [m] > 0: grid beyond each free side face and above the specimen's top, beside the platen (default
+    UNIAXIAL_SIDE_ROOM): a top corner that fails is squeezed out sideways at up to 10 m/s and rises past the
+    platen's edge (the 0.5 mm, c_con = 5 MPa run lost such a particle 1 mm above the top at 10.9 ms when the grid
+    ended 2 cells above the specimen).
     slab_cells ≥ 0: 0 (default) = 2D plane strain; n > 0 = the same specimen as a 3D slab n cells thick
     (z ∈ [0, n·l]) between two slip (symmetry) planes on its front and back faces, i.e. plane strain
     imposed by the boundary instead of the kinematics (doc/three_d.md); the flaw is a through prism and the
@@ -106,7 +109,7 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     rock = material or rocks.miao2018_sandstone()
     side = side_room                               # grid room beside the free faces for spalled fragments
     zt = (T,) if slab_cells else ()
-    s = make_solver((-side, 0) + z, (W + side, H) + zt, spacing, margin=2)
+    s = make_solver((-side, 0) + z, (W + side, H + side) + zt, spacing, margin=2)   # room above too: fragments rise beside the platen
     add_region(s, rock, (0, 0) + z, (W, H) + zt, ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     if slab_cells:                                 # front and back faces: slip (symmetry) planes

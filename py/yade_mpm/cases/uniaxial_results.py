@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from .. import analysis
+from .._core import MpmSimulationError
 from ..fields import get as _get, fields as _fields
 from .uniaxial import uniaxial_flaw_geometry
 
@@ -53,7 +54,8 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
     the platen's curve (t, ε, σ) after every step, `snapshot` (e.g. field_snapshots) and VTU files into FOLDER when
     due (`snapshot_when`, `vtu_when`: runner.Output timing, e.g. dict(period=1e-3, at_end=True)), extra runner
     outputs, a stop after the peak (stop_when_softened). Steps through YADE (O.step: the platen is a YADE body).
-    Writes FOLDER/curve.csv (time_s, axial_strain, axial_stress_MPa). Returns dict(result = runner's, wall_s,
+    Writes FOLDER/curve.csv (time_s, axial_strain, axial_stress_MPa), also when the solver stops the run with an
+    error after the first step (result.reason "error", result.error its message: what was measured stays). Returns dict(result = runner's, wall_s,
     t, eps, sig [Pa] arrays, peak = index of the peak, E = Young's modulus [Pa] by peak_and_modulus)."""
     import time
     from yade import O
@@ -64,9 +66,16 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
         curve.append((s.time, scene["axial_strain"](), scene["axial_stress"]()))
 
     t0 = time.time()
-    res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
-                     outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
-                              runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs))
+    try:
+        res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
+                         outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
+                                  runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs))
+    except (MpmSimulationError, RuntimeError) as e:   # the solver refused the state (through YADE: a RuntimeError):
+        res = runner.RunResult("error", solver.steps, solver.time, time.time() - t0)   # keep the curve measured up to it
+        res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
+        print(f"[{label}] stopped by the solver at t = {solver.time:.6g} s: {res.error}", flush=True)
+        if not curve:
+            raise
     wall = time.time() - t0
     t, eps, sig = np.array(curve).T
     output.write_csv(os.path.join(folder, "curve.csv"), ["time_s", "axial_strain", "axial_stress_MPa"], np.column_stack([t, eps, sig / 1e6]))
