@@ -12,7 +12,7 @@ Folders read (each optional; a missing one is reported with the command that mak
     circular_opening_paper/, penny_crack_paper/   the elastic benchmarks at the paper's grid (0.01 m, 0.02 m)
     stability/         scripts/stability.py
     uniaxial_flaw/     scripts/uniaxial_flaw.py
-    uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: intact, open, filled μ_con 0–0.6, c_con 5 and 10 MPa)
+    uniaxial_paper/    scripts/uniaxial_flaw.py --paper   (paper grid: open, filled μ_con 0 and 0.6, c_con 5 and 10 MPa)
     tunnel/            scripts/tunnel_spalling.py            (default grid, all four cases)
     tunnel_paper/      scripts/tunnel_spalling.py --paper    (paper grid)
     fidelity_variants/ scripts/fidelity_variants.py          (variant screening; notes.md: how it was run)
@@ -37,7 +37,7 @@ PARTS = {
     "stability": "/usr/bin/python3 scripts/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel)",
-    "uniaxial_paper": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs intact,open,filled:0:0,filled:0.2:0,filled:0.4:0,filled:0.6:0,filled:0:5,filled:0:10",
+    "uniaxial_paper": "/usr/bin/python3 scripts/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs open,filled:0:0,filled:0.6:0,filled:0:5,filled:0:10",
     "tunnel_paper": "/usr/bin/python3 scripts/tunnel_spalling.py --out out/tunnel_paper --paper --threads 2 --cases intact,open_flaw,filled_flaw",
 }
 
@@ -217,6 +217,10 @@ def stability(R):
     R.figures("stability", ["energy_ratio.png"])
 
 
+RUN_COLUMNS = ("variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s", "end_reason",
+               "time_reached_s", "wall_time_s", "particles")   # a uniaxial run's row: how and when it ended beside its peak
+
+
 def include_notes(R, path):
     """A notes file of the output folder (how the runs were made, written by whoever ran them), verbatim, if present."""
     if os.path.exists(path):
@@ -234,7 +238,8 @@ def uniaxial(R, part="uniaxial_flaw", title="Uniaxial compression with a flaw (p
         R.w(*table([{"k": k, "v": v} for k, v in flat.items()], [("quantity", lambda r: r["k"]), ("value", lambda r: r["v"])]))
     for k, v in s.items():
         if isinstance(v, list) and v and isinstance(v[0], dict):
-            keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None][:8]
+            keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None]
+            keys = [c for c in RUN_COLUMNS if c in keys] or keys[:8]
             R.w(f"**{k}**", "")
             R.w(*table(v, [(c, (lambda c: lambda r: r.get(c))(c)) for c in keys]))
     R.figures(part, ["curves_mu.png", "curves_c.png", "damage_plastic_open.png", "damage_plastic_filled_mu0.6_c0MPa.png"])

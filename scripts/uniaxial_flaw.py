@@ -112,7 +112,7 @@ def one_run(variant, mu, c_mpa, a):
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=r["result"].reason,
-                 error=getattr(r["result"], "error", None),
+                 error=getattr(r["result"], "error", None), time_reached_s=float(t[-1]),
                  softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, courant=a.courant,
                  filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},

@@ -201,8 +201,8 @@ def u_scatter(u):
 PAPER_UNIAXIAL = ("not run: at 0.5 mm the open-flaw scene has 119,200 particles (16× 2 mm's) and 8,460 steps per ms (4×), "
                   "64× the particle-steps; a 0.1 ms probe ran 1.38 M particle-steps/s on one shared thread, so one run to its "
                   "post-peak stop (≈ 75,000 steps) needs ≈ 110 min, over the session's budget")
-PAPER_UNIAXIAL_SUBSET = ("not run at 0.5 mm: the paper grid ran the open flaw and the rigid-filled flaw (μ_con = 0.6) only, "
-                         "not the intact specimen or the μ_con / c_con sweeps")
+PAPER_UNIAXIAL_SUBSET = ("not run at 0.5 mm: a run this row needs is not among the paper-grid runs (their list: the section "
+                         "'Uniaxial compression with a flaw at the paper's grid' below)")
 PAPER_TUNNEL = ("not run at l = 1 mm with this build; the last 1 mm runs (an earlier build, ε̄p grown by the von Mises "
                 "Δλ/√3 before issue 18) are in doc/paper_grid_and_courant_7ac11e5.md")
 PAPER_BENCH = "not run at the paper's grid"

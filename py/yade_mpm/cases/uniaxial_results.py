@@ -17,7 +17,8 @@ from .uniaxial import uniaxial_flaw_geometry
 SUMMARY_KEYS = ("variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "youngs_modulus_GPa", "wall_time_s",
                 "particles", "steps", "particle_steps_per_s")            # peaks.csv / peaks.md columns
 RUN_KEYS = SUMMARY_KEYS + ("time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end", "crack_times", "near_flaw_sigma_max",
-                           "plastic_before_peak", "cracks_end", "flaw_end_cracks_end", "shear_bands_end")   # summary.json runs
+                           "plastic_before_peak", "cracks_end", "flaw_end_cracks_end", "shear_bands_end",
+                           "time_reached_s", "error")   # summary.json runs
 ROW_KEYS = ("variant", "mu_con", "c_con_MPa", "spacing_m", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s",
             "youngs_modulus_GPa", "particles", "steps", "end_reason", "softened", "damaged_fraction_end")   # a study's row
 
