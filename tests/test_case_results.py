@@ -65,3 +65,21 @@ def test_compression_run_keeps_the_curve_when_the_solver_stops_the_run(tmp_path)
     c = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
     assert len(c) == 30 and np.all(np.diff(c[:, 0]) > 0) and c[-1, 2] > 0       # every step before the refused one
     assert len(r["t"]) == 30 and r["peak"] == int(np.argmax(r["sig"]))
+
+
+def test_compression_run_ends_cleanly_on_sigterm(tmp_path):
+    # kill PID of a background loading run: the curve up to the signal is written and the run says "interrupted"
+    import os
+    import signal
+    from yade_mpm import cases, runner
+    s, sc = cases.uniaxial_flaw("intact", 0.005, side_room=0.01)
+
+    def term(solver):
+        if solver.steps == 20:
+            os.kill(os.getpid(), signal.SIGTERM)
+    r = uniaxial_results.compression_run(s, sc, str(tmp_path), 1e-3, 1e9, "term", lambda solver: None, dict(steps=1000),
+                                         dict(period=1.0), [runner.Output(term, steps=1)])
+    assert r["result"].reason == "interrupted"
+    c = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
+    assert 20 <= len(c) <= 21 and c[-1, 2] > 0
+    assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL       # the handler is gone after the run

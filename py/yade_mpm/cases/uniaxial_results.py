@@ -2,10 +2,12 @@
 scripts/uniaxial_flaw.py and any study of the scene: the post-peak stop, the curve's peak and modulus,
 the crack analytics at the end of a run, and the runs' summary read back from OUT/runs/NAME/run.json.
 Quantities are SI inside; the JSON-able records name their units (MPa, GPa)."""
+import contextlib
 import glob
 import json
 import math
 import os
+import signal
 
 import numpy as np
 
@@ -50,13 +52,33 @@ def field_snapshots(snaps, names=("pos", "damage", "plastic_strain"), dtype=None
     return snapshot
 
 
+@contextlib.contextmanager
+def _terminate_as_interrupt():
+    """SIGTERM raises KeyboardInterrupt inside the block (the runner then ends the run cleanly), and SIGINT does too
+    even when the process started with it ignored (a background job); the old handlers come back after."""
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+    old = {}
+    try:
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            old[sig] = signal.signal(sig, handler)
+    except ValueError:                           # not the main thread: no handlers, the defaults stay
+        pass
+    try:
+        yield
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
+
+
 def compression_run(solver, scene, folder, end_time, progress, label, snapshot, snapshot_when, vtu_when, outputs=()):
     """The loading loop of a compression specimen, written once for the uniaxial scripts (2D, 3D slab, penny prism):
     the platen's curve (t, ε, σ) after every step, `snapshot` (e.g. field_snapshots) and VTU files into FOLDER when
     due (`snapshot_when`, `vtu_when`: runner.Output timing, e.g. dict(period=1e-3, at_end=True)), extra runner
     outputs, a stop after the peak (stop_when_softened). Steps through YADE (O.step: the platen is a YADE body).
     Writes FOLDER/curve.csv (time_s, axial_strain, axial_stress_MPa), also when the solver stops the run with an
-    error after the first step (result.reason "error", result.error its message: what was measured stays). Returns dict(result = runner's, wall_s,
+    error after the first step (result.reason "error", result.error its message: what was measured stays) and when
+    the run is interrupted (Ctrl-C or SIGTERM: result.reason "interrupted"). Returns dict(result = runner's, wall_s,
     t, eps, sig [Pa] arrays, peak = index of the peak, E = Young's modulus [Pa] by peak_and_modulus)."""
     import time
     from yade import O
@@ -68,9 +90,11 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
 
     t0 = time.time()
     try:
-        res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
-                         outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
-                                  runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs))
+        with _terminate_as_interrupt():          # SIGTERM (e.g. kill of a background run) ends the run as Ctrl-C does
+            res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
+                             outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
+                                      runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs),
+                             on_interrupt="return")
     except (MpmSimulationError, RuntimeError) as e:   # the solver refused the state (through YADE: a RuntimeError):
         res = runner.RunResult("error", solver.steps, solver.time, time.time() - t0)   # keep the curve measured up to it
         res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
