@@ -96,9 +96,11 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
                                       runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs),
                              on_interrupt="return")
     except (MpmSimulationError, RuntimeError) as e:   # the solver refused the state (through YADE: a RuntimeError):
-        res = runner.RunResult("error", solver.steps, solver.time, time.time() - t0)   # keep the curve measured up to it
-        res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
-        print(f"[{label}] stopped by the solver at t = {solver.time:.6g} s: {res.error}", flush=True)
+        interrupted = "KeyboardInterrupt" in str(e)  # the signal arrived inside YADE's PyRunner, which wraps it
+        res = runner.RunResult("interrupted" if interrupted else "error", solver.steps, solver.time, time.time() - t0)
+        if not interrupted:                          # keep the curve measured up to the error
+            res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
+            print(f"[{label}] stopped by the solver at t = {solver.time:.6g} s: {res.error}", flush=True)
         if not curve:
             raise
     wall = time.time() - t0
