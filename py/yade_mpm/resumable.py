@@ -13,10 +13,9 @@ import json
 import math
 import numbers
 import os
-import signal
 import time
 
-from .runner import STOP, TIME_TOL, Output, run
+from .runner import STOP, TIME_TOL, Output, SignalStop, run
 
 
 def _real(x):
@@ -119,29 +118,11 @@ class Checkpointer:
         instead of killing the process; a second signal stops at once. Handlers restored on exit."""
         ck = self
 
-        class _Guard:
-            def __enter__(self):
-                self.old = {}
-                for sig in (signal.SIGINT, signal.SIGTERM):
-                    try:
-                        self.old[sig] = signal.signal(sig, self.handler)
-                    except ValueError:            # not the main thread: no signal handling
-                        pass
-                return ck
-
-            def handler(self, signum, frame):
-                if ck.stop_requested:             # second signal: give up the clean stop
-                    raise KeyboardInterrupt
-                ck.stop_requested, ck.signal_name = True, signal.Signals(signum).name
-                print(f"\n[checkpoint] {ck.signal_name}: writing a last checkpoint and the outputs, then stopping "
-                      "(send it again to stop at once)", flush=True)
-
-            def __exit__(self, *exc):
-                for sig, h in self.old.items():
-                    signal.signal(sig, h)
-                return False
-
-        return _Guard()
+        def first(name):
+            ck.stop_requested, ck.signal_name = True, name
+            print(f"\n[checkpoint] {name}: writing a last checkpoint and the outputs, then stopping "
+                  "(send it again to stop at once)", flush=True)
+        return SignalStop(first, already=lambda: ck.stop_requested)
 
 
 class ResumableRun:

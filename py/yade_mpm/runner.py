@@ -27,6 +27,7 @@ at once, without the ``at_end`` outputs, since the state is then half-updated.
 """
 import math
 import numbers
+import signal
 import time as _time
 
 from .progress import Progress
@@ -34,6 +35,39 @@ from .progress import Progress
 # relative tolerance on simulated times: a step ending within 1e-12·t of a target counts as reaching it
 # (a sum of Δt rarely hits a target exactly)
 TIME_TOL = 1e-12
+
+
+class SignalStop:
+    """Context manager: SIGINT and SIGTERM ask the run to end at the next step boundary instead of killing
+    the process (SIGINT too when the process started with it ignored, a background job). The first signal
+    sets `requested` and `name` and calls `on_first(name)`; a signal while `already()` (default: `requested`)
+    holds raises KeyboardInterrupt at once. Handlers restored on exit; outside the main thread none are
+    installed. A run reads `requested` in its `stop` or an Output (the checkpointer's, compression_run's)."""
+
+    def __init__(self, on_first=None, already=None):
+        self.requested, self.name = False, None
+        self.on_first, self.already = on_first, already or (lambda: self.requested)
+
+    def __enter__(self):
+        self.old = {}
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            try:
+                self.old[sig] = signal.signal(sig, self._handler)
+            except ValueError:                    # not the main thread: no signal handling
+                pass
+        return self
+
+    def _handler(self, signum, frame):
+        if self.already():                        # second signal: give up the clean stop
+            raise KeyboardInterrupt
+        self.requested, self.name = True, signal.Signals(signum).name
+        if self.on_first:
+            self.on_first(self.name)
+
+    def __exit__(self, *exc):
+        for sig, h in self.old.items():
+            signal.signal(sig, h)
+        return False
 
 
 class _Stop:

@@ -2,12 +2,10 @@
 scripts/uniaxial_flaw.py and any study of the scene: the post-peak stop, the curve's peak and modulus,
 the crack analytics at the end of a run, and the runs' summary read back from OUT/runs/NAME/run.json.
 Quantities are SI inside; the JSON-able records name their units (MPa, GPa)."""
-import contextlib
 import glob
 import json
 import math
 import os
-import signal
 
 import numpy as np
 
@@ -52,25 +50,6 @@ def field_snapshots(snaps, names=("pos", "damage", "plastic_strain"), dtype=None
     return snapshot
 
 
-@contextlib.contextmanager
-def _terminate_as_interrupt():
-    """SIGTERM raises KeyboardInterrupt inside the block (the runner then ends the run cleanly), and SIGINT does too
-    even when the process started with it ignored (a background job); the old handlers come back after."""
-    def handler(signum, frame):
-        raise KeyboardInterrupt
-    old = {}
-    try:
-        for sig in (signal.SIGTERM, signal.SIGINT):
-            old[sig] = signal.signal(sig, handler)
-    except ValueError:                           # not the main thread: no handlers, the defaults stay
-        pass
-    try:
-        yield
-    finally:
-        for sig, h in old.items():
-            signal.signal(sig, h)
-
-
 def compression_run(solver, scene, folder, end_time, progress, label, snapshot, snapshot_when, vtu_when, outputs=()):
     """The loading loop of a compression specimen, written once for the uniaxial scripts (2D, 3D slab, penny prism):
     the platen's curve (t, ε, σ) after every step, `snapshot` (e.g. field_snapshots) and VTU files into FOLDER when
@@ -89,18 +68,20 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
         curve.append((s.time, scene["axial_strain"](), scene["axial_stress"]()))
 
     t0 = time.time()
+    softened = stop_when_softened(curve)
     try:
-        with _terminate_as_interrupt():          # SIGTERM (e.g. kill of a background run) ends the run as Ctrl-C does
-            res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step, stop=stop_when_softened(curve),
+        with runner.SignalStop() as sig:             # SIGINT/SIGTERM (a kill of a background run): end after this step
+            res = runner.run(solver, end_time=end_time, progress=progress, label=label, advance=O.step,
+                             stop=lambda s: sig.requested or softened(s),
                              outputs=[runner.Output(record, steps=1), runner.Output(snapshot, **snapshot_when),
                                       runner.Output(output.VtuSeries(folder).write, **vtu_when)] + list(outputs),
                              on_interrupt="return")
+        if sig.requested:
+            res.reason = "interrupted"
     except (MpmSimulationError, RuntimeError) as e:   # the solver refused the state (through YADE: a RuntimeError):
-        interrupted = "KeyboardInterrupt" in str(e)  # the signal arrived inside YADE's PyRunner, which wraps it
-        res = runner.RunResult("interrupted" if interrupted else "error", solver.steps, solver.time, time.time() - t0)
-        if not interrupted:                          # keep the curve measured up to the error
-            res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
-            print(f"[{label}] stopped by the solver at t = {solver.time:.6g} s: {res.error}", flush=True)
+        res = runner.RunResult("error", solver.steps, solver.time, time.time() - t0)   # keep the curve measured up to it
+        res.error = str(e).split("ERROR:")[-1].strip().splitlines()[0]
+        print(f"[{label}] stopped by the solver at t = {solver.time:.6g} s: {res.error}", flush=True)
         if not curve:
             raise
     wall = time.time() - t0
