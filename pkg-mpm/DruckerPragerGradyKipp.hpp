@@ -152,9 +152,12 @@ struct DruckerPragerGradyKipp {
 	{
 		ReturnInfo r;
 		Sym<D>     dev = s;
-		const Real sm  = dev.toDeviator();
-		const Real tau = std::sqrt(0.5 * dev.contract());
-		const Real c   = mat.cohesionAt(epsP);
+		const Real sm   = dev.toDeviator();
+		const Real tau2 = 0.5 * dev.contract();
+		const Real c    = mat.cohesionAt(epsP);
+		const Real room = kphi * c - qphi * sm; // Eq. 30: F = τ − room ≤ 0 ⇔ room ≥ 0 and τ² ≤ room² (no root for elastic points)
+		if (room >= 0 && tau2 <= room * room) return r;
+		const Real tau = std::sqrt(tau2);
 		const Real F   = tau + qphi * sm - kphi * c; // Eq. 30
 		if (F <= 0) return r;
 		// Cone return with the non-associated potential (Eqs. 32–33): τ ← τ − GΔλ, σm ← σm − K qψ Δλ.
@@ -204,7 +207,7 @@ struct DruckerPragerGradyKipp {
 	// whose thresholds ε̄ has passed are activated and D is capped by their fraction (Benz & Asphaug 1995).
 	void damageGrowth(const Sym<D>& s, Real& Dmg, Real eps0, Real dt, Real* nFlaw = nullptr, Real vol0 = 0, int64_t id = 0) const
 	{
-		if (Dmg >= 1) return;
+		if (Dmg >= 1 || !mayBeTensile(s)) return;
 		const Real smax = maxPrincipal(s);
 		if (smax <= 0) return;
 		const Real eb = damageStrain(s, smax); // Eq. 36
@@ -237,7 +240,7 @@ struct DruckerPragerGradyKipp {
 	// Eq. 40: tensile principal stresses scaled by (1 − D), rotated back; compression unchanged.
 	static Sym<D> damaged(const Sym<D>& s, Real Dmg)
 	{
-		if (Dmg <= 0) return s;
+		if (Dmg <= 0 || !mayBeTensile(s)) return s;
 		auto pr = Principal<D>::of(s);
 		if (pr.value[0] <= 0) return s;
 		Real v[3];

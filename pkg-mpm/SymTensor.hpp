@@ -140,4 +140,21 @@ inline Real maxPrincipal(const Sym<D>& s)
 	}
 }
 
+// Whether σ may have a tensile principal value (σ1 > 0), without a root or a decomposition: in 2D exactly
+// max(a + √(b² + τ²), σzz) > 0 with a = (σxx + σyy)/2, b = (σxx − σyy)/2 (a + r > 0 ⇔ a > 0 or r² > a²); in 3D by
+// Gershgorin's bound σ1 ≤ maxᵢ(σᵢᵢ + Σⱼ≠ᵢ |σᵢⱼ|), so false means σ1 ≤ 0 and true may still be compression. The
+// damage model (Eqs. 35–40) acts on tension only; most rock in a loaded scene is compressed, so this test
+// spares it the decomposition (issue 19).
+template <int D>
+inline bool mayBeTensile(const Sym<D>& s)
+{
+	if constexpr (D == 2) {
+		const Real a = 0.5 * (s.c[0] + s.c[1]), b = 0.5 * (s.c[0] - s.c[1]);
+		return s.c[2] > 0 || a > 0 || b * b + s.c[3] * s.c[3] > a * a;
+	} else {
+		const Real xy = std::abs(s.c[3]), xz = std::abs(s.c[4]), yz = std::abs(s.c[5]);
+		return s.c[0] + xy + xz > 0 || s.c[1] + xy + yz > 0 || s.c[2] + xz + yz > 0;
+	}
+}
+
 } // namespace mpm
