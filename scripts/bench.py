@@ -289,7 +289,8 @@ def kernel_bound(p, threads, out, repeats):
     """The paper tunnel's particle-steps at the ceiling kernel's own DP rate (2D 80 k block, the same threads and
     wait policy, this host, this run): the wall time no code of the kernel's shape could beat at this C. The
     kernel's DP block does less per particle than the tunnel (USL, no Jaumann rate, no damage growth, no contact),
-    so this is a lower bound of what issue 19's 300 s bar asks of the step. {} when the kernel source is absent."""
+    so this is a lower bound of what issue 19's 300 s bar asks of the step; the fastest of ≥ 3 kernel runs is taken.
+    {} when the kernel source is absent."""
     import bench_kernel
     if not os.path.exists(bench_kernel.SOURCE):
         print(f"[bench] ceiling kernel not found at {bench_kernel.SOURCE}: no kernel bound", flush=True)
@@ -298,12 +299,14 @@ def kernel_bound(p, threads, out, repeats):
     env = dict(os.environ, OMP_PROC_BIND="false")
     if WAIT_POLICY:
         env["OMP_WAIT_POLICY"] = WAIT_POLICY
-    rate = statistics.median(bench_kernel.run_kernel(exe, "dp", threads, env)[0] for _ in range(repeats))
+    rates = [bench_kernel.run_kernel(exe, "dp", threads, env)[0] for _ in range(max(repeats, 3))]
+    rate = max(rates)  # a ceiling: the fastest run (2-thread runs of the kernel on a shared VM scatter by up to 2x)
     wall = p["steps_needed"] * p["particles"] / rate
-    print(f"[bench] ceiling kernel, DP block 80 k, {threads}T: {rate / 1e6:.2f} M p-steps/s → the tunnel's "
+    print(f"[bench] ceiling kernel, DP block 80 k, {threads}T: fastest of {len(rates)} runs {rate / 1e6:.2f} M p-steps/s "
+          f"(all: {', '.join(f'{r / 1e6:.1f}' for r in rates)}) → the tunnel's "
           f"{p['steps_needed'] * p['particles'] / 1e9:.2f} G particle-steps would take {wall:.0f} s at the kernel's own rate "
           f"(C = {p['courant']}; this code: {p['extrapolated_wall_s'] / wall:.2f}× that)", flush=True)
-    return dict(kernel_dp_rate=rate, kernel_bound_wall_s=wall)
+    return dict(kernel_dp_rate=rate, kernel_dp_rates=rates, kernel_bound_wall_s=wall)
 
 
 def spawn(case, mode, threads, steps, warmup):
