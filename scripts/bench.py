@@ -290,20 +290,14 @@ def kernel_bound(p, threads, out, repeats):
     wait policy, this host, this run): the wall time no code of the kernel's shape could beat at this C. The
     kernel's DP block does less per particle than the tunnel (USL, no Jaumann rate, no damage growth, no contact),
     so this is a lower bound of what issue 19's 300 s bar asks of the step; the fastest of ≥ 3 kernel runs is taken.
-    {} when the kernel source is absent."""
+    {} when the kernel cannot be built."""
     import bench_kernel
-    if not os.path.exists(bench_kernel.SOURCE):
-        print(f"[bench] ceiling kernel not found at {bench_kernel.SOURCE}: no kernel bound", flush=True)
-        return {}
     try:
         exe = bench_kernel.build_kernel(bench_kernel.SOURCE, os.path.join(os.path.abspath(out), "kernel"))
-    except (SystemExit, OSError) as e:  # no g++, or the kernel changed shape: the bench itself goes on
+    except (SystemExit, OSError) as e:  # no kernel source beside the checkout, no g++, or the kernel changed shape
         print(f"[bench] ceiling kernel not built ({e}): no kernel bound", flush=True)
         return {}
-    env = dict(os.environ, OMP_PROC_BIND="false")
-    if WAIT_POLICY:
-        env["OMP_WAIT_POLICY"] = WAIT_POLICY
-    rates = [bench_kernel.run_kernel(exe, "dp", threads, env)[0] for _ in range(max(repeats, 3))]
+    rates = [bench_kernel.run_kernel(exe, "dp", threads, child_env(threads))[0] for _ in range(max(repeats, 3))]
     rate = max(rates)  # a ceiling: the fastest run (2-thread runs of the kernel on a shared VM scatter by up to 2x)
     wall = p["steps_needed"] * p["particles"] / rate
     print(f"[bench] ceiling kernel, DP block 80 k, {threads}T: fastest of {len(rates)} runs {rate / 1e6:.2f} M p-steps/s "
@@ -313,10 +307,16 @@ def kernel_bound(p, threads, out, repeats):
     return dict(kernel_dp_rate=rate, kernel_dp_rates=rates, kernel_bound_wall_s=wall)
 
 
-def spawn(case, mode, threads, steps, warmup):
+def child_env(threads):
+    """Environment of a timed child process (this build's or the kernel's): thread count, no binding, the wait policy."""
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="false")
     if WAIT_POLICY:
         env["OMP_WAIT_POLICY"] = WAIT_POLICY
+    return env
+
+
+def spawn(case, mode, threads, steps, warmup):
+    env = child_env(threads)
     cmd = [sys.executable, os.path.abspath(__file__), "--child", "--mode", mode, "--case", case, "--steps", str(steps),
            "--warmup", str(warmup)]
     r = subprocess.run(cmd, env=env, capture_output=True, text=True)

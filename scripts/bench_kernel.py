@@ -102,25 +102,25 @@ def main():
     builds = [b.split("=", 1) for b in a.builds]
     if a.rounds < 1:
         raise SystemExit("--rounds must be >= 1")
-    exe = build_kernel(a.kernel_source, os.path.abspath(a.kernel_dir))
-    if a.float_kernel:
-        builds.append(("float-kernel", build_kernel(a.kernel_source, os.path.abspath(a.kernel_dir), "float")))
     mat = "dp" if a.case.startswith("dpgk") else "elastic"
+    kernels = [("kernel", "double")] + ([("float-kernel", "float")] if a.float_kernel else [])
+    order = [(name, (lambda exe: lambda: run_kernel(exe, mat))(build_kernel(a.kernel_source, os.path.abspath(a.kernel_dir), prec)))
+             for name, prec in kernels]
+    order += [(name, (lambda py: lambda: run_build(py, a.case))(py)) for name, py in builds]
+    compared = [name for name, _ in order[1:]]   # each against the double kernel of its round
     print(f"load average at start: {os.getloadavg()}", flush=True)
-    ratios = {n: [] for n, _ in builds}
+    ratios = {n: [] for n in compared}
     for k in range(a.rounds):
-        order = [("kernel", None)] + builds
         row = {}
-        for name, py in (order if k % 2 == 0 else order[::-1]):
-            row[name] = (run_kernel(exe, mat) if py is None else run_kernel(py, mat) if name == "float-kernel"
-                         else run_build(py, a.case))
+        for name, run1 in (order if k % 2 == 0 else order[::-1]):
+            row[name] = run1()
             print(f"round {k} {name}: {row[name][0] / 1e6:.2f} M/s wall, {row[name][1] / 1e6:.2f} M/s CPU; {row[name][2]}", flush=True)
-        for name, _ in builds:
+        for name in compared:
             r = (row[name][0] / row["kernel"][0], row[name][1] / row["kernel"][1])
             ratios[name].append(r)
             print(f"  round {k} {name} / kernel: wall {r[0]:.3f}, CPU {r[1]:.3f}", flush=True)
     print(f"load average at end: {os.getloadavg()}")
-    for name, _ in builds:
+    for name in compared:
         print(f"MEDIAN {name} / kernel ({a.case}, 1 thread, {a.rounds} rounds): wall {statistics.median(r[0] for r in ratios[name]):.3f}, "
               f"CPU {statistics.median(r[1] for r in ratios[name]):.3f}" + ("  (the all-float kernel's speed-up)" if name == "float-kernel" else "  (issue 19 bar: 0.7)"))
 
