@@ -97,6 +97,20 @@ struct BlockSchedule {
 		return true;
 	}
 
+	// The particles with drop[p] == 1 are taken out of the storage (Particles::compact): each block keeps its
+	// other particles, in their order, so the schedule stays valid without a re-sort.
+	void dropSlots(const std::vector<uint8_t>& drop)
+	{
+		uint32_t gone = 0;
+		for (size_t b = 0; b + 1 < start.size(); ++b) {
+			const uint32_t s0 = start[b], s1 = start[b + 1];
+			start[b] -= gone;
+			for (uint32_t p = s0; p < s1; ++p) gone += drop[p];
+		}
+		if (!start.empty()) start.back() -= gone;
+		buildColours();
+	}
+
 	void buildColours()
 	{
 		const size_t nb = blockCount();

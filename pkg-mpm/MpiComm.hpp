@@ -7,6 +7,7 @@
 // stored as doubles (exact), so every rank gets the same bits.
 #pragma once
 #include "MpmTypes.hpp"
+#include <algorithm>
 #include <vector>
 
 #ifdef MPM_MPI
@@ -42,6 +43,10 @@ struct Comm {
 	static void max(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, world()); }
 	static void min(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MIN, world()); }
 	static void sum(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, world()); }
+	static void maxBytes(uint8_t* v, size_t n) // element-wise max of a byte map (cell occupancy), in chunks of < 2^31
+	{
+		for (size_t k = 0; k < n; k += size_t(INT32_MAX)) MPI_Allreduce(MPI_IN_PLACE, v + k, int(std::min(n - k, size_t(INT32_MAX))), MPI_UINT8_T, MPI_MAX, world());
+	}
 	// v ← Σ_r v_r summed in rank order 0, 1, …, R − 1 on every rank (an all-gather, then the same additions
 	// everywhere): the same bits on every rank for any rank count (MPI_SUM leaves the order to the library).
 	static void sumInRankOrder(double* v, int n, std::vector<double>& all) // all: scratch

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace mpm {
 
@@ -40,12 +41,21 @@ struct ErrorRecord {
 	static constexpr size_t elsewhere = SIZE_MAX - 1; // MPI build: the phase failed on another rank
 	size_t      particle = SIZE_MAX;
 	std::string what;
-	void        clear() { particle = SIZE_MAX, what.clear(); }
+	// Position update: particles that left the grid (not a failure yet: the solver's outside policy decides,
+	// Solver::settleLeaving); filled in any order by the threads, only on the rare steps where one leaves.
+	std::vector<size_t> left;
+	bool                leftAnywhere = false; // MPI build: some rank has particles in `left` (reduceStep)
+	void        clear() { particle = SIZE_MAX, what.clear(), left.clear(), leftAnywhere = false; }
 	bool        none() const { return particle == SIZE_MAX; }
 	void        record(size_t p, const std::string& w)
 	{
 #pragma omp critical(mpm_error)
 		if (p < particle) particle = p, what = w;
+	}
+	void recordLeft(size_t p)
+	{
+#pragma omp critical(mpm_error)
+		left.push_back(p), leftAnywhere = true;
 	}
 };
 

@@ -87,8 +87,7 @@ inline void recordMoveFailures(const Particles<D>& P, const Grid<D>& grid, uint3
 		}
 		for (int a = 0; a < D; ++a)
 			if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) {
-				err.record(p, "left the grid along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (grid spans [" + fmtNum(lo[a]) + ", "
-				                      + fmtNum(hi[a]) + ") m)");
+				err.recordLeft(p); // not a failure yet: the solver's outside policy decides (Solver::settleLeaving)
 				break;
 			} else if (P.x[a][p] < alo[a] || P.x[a][p] >= ahi[a]) {
 				err.record(p, "crossed a boundary plane along axis " + std::to_string(a) + " at x = " + fmtNum(P.x[a][p]) + " m (allowed: ["
@@ -98,8 +97,33 @@ inline void recordMoveFailures(const Particles<D>& P, const Grid<D>& grid, uint3
 	}
 }
 
+// The grid face particle p left through (position past the grid's edge): 2·axis + (1 if past the upper end),
+// the first axis along which it is outside; −1 if it is on the grid.
+template <int D>
+inline int exitFace(const Particles<D>& P, const Grid<D>& grid, size_t p)
+{
+	const auto lo = grid.origin, hi = grid.upper();
+	for (int a = 0; a < D; ++a)
+		if (P.x[a][p] < lo[a] || P.x[a][p] >= hi[a]) return 2 * a + (P.x[a][p] >= hi[a] ? 1 : 0);
+	return -1;
+}
+inline std::string faceName(int f) { return f < 0 ? "none" : std::string(1, "xyz"[f / 2]) + (f % 2 ? "+" : "-"); }
+
+// The message of a particle that left the grid (the run stops): axis, face, the coordinate and the whole position.
+template <int D>
+inline std::string leftGridMessage(const Particles<D>& P, const Grid<D>& grid, size_t p)
+{
+	const int         f = exitFace(P, grid, p), a = f / 2;
+	const auto        lo = grid.origin, hi = grid.upper();
+	std::string       pos = "(";
+	for (int b = 0; b < D; ++b) pos += (b ? ", " : "") + fmtNum(P.x[b][p]);
+	return "left the grid along axis " + std::to_string(a) + " through its " + faceName(f) + " face at x = " + fmtNum(P.x[a][p]) + " m, position " + pos
+	       + ") m (grid spans [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m along axis " + std::to_string(a) + ")";
+}
+
 // x ← x + Δt v (the G2P velocity) for the particles of block b. Checks that each stays finite and on the
-// grid cut by the boundary planes (else err) and within the cells its block may reach before a re-sort
+// grid cut by the boundary planes (else err; a particle past the grid's edge goes to err.left, for the
+// solver's outside policy) and within the cells its block may reach before a re-sort
 // (BlockSchedule::reach): drift is set when one left them, so the deterministic colouring stays valid.
 // Raises v2max to the largest ‖v‖² (for Δt). A branch-free loop over the arrays; the messages are built
 // only when a particle failed.

@@ -177,6 +177,22 @@ struct Particles {
 		for (int k = 0; k < NS; ++k) sig[k][p] = s.c[k];
 	}
 
+	// Keeps the particles with drop[p] == 0, in their order (particles removed after leaving the grid); the
+	// arrays shrink in place (no reallocation).
+	void compact(const std::vector<uint8_t>& drop)
+	{
+		size_t k       = 0;
+		auto   squeeze = [&](auto& f) {
+			k = 0;
+			for (size_t p = 0; p < n; ++p)
+				if (!drop[p]) f[k++] = f[p];
+			f.resize(k);
+		};
+		forEachRealField(squeeze);
+		squeeze(id), squeeze(mat);
+		n = k;
+	}
+
 	// Applies particle order perm (new slot k holds old particle perm[k]) to every field.
 	// tmp, idTmp: work buffers kept by the caller, so a re-sort allocates nothing once they have grown.
 	void permute(const std::vector<uint32_t>& perm, std::vector<Real>& tmp, std::vector<int64_t>& idTmp)

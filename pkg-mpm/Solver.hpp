@@ -6,6 +6,7 @@
 #include "Decomposition.hpp"
 #include "MaterialSet.hpp"
 #include "MuslStep.hpp"
+#include "Removal.hpp"
 #include "SolverSettings.hpp"
 #include <omp.h>
 
@@ -164,6 +165,7 @@ public:
 			auto        st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
 			MPM_IF_MPI(dd.reduceStep(st.rhoMin, st.v2max, st.drift, errStress, errMove);) // global Δt limits, re-sort flag
 			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
+			if (errMove.leftAnywhere) settleLeaving(errMove, dt); // a particle left the grid (on some rank): outside policy
 			vmax = std::sqrt(st.v2max), rhoMin = st.rhoMin;
 			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
 			t[5] = omp_get_wtime();
@@ -191,6 +193,31 @@ public:
 	const BlockSchedule<D>& schedule() const { return sched; }
 	// Python calls this after writing particle views: re-sort and re-validate before the next step.
 	void requestSort() { needSort = needCheck = true; }
+
+	// ---------------------------------------------------------------- material that left the grid (Removal.hpp)
+	// The removed particles in removal order (this rank's, MPI build) and their running account.
+	const std::vector<RemovedParticle<D>>& removedParticles() const { return removed; }
+	const RemovedAccount<D>&               removedAccount() const { return removedSum; }
+	// Checkpoint resume: the saved records (their account recomputed in the same order: the same bits), and
+	// the particle arrays cut to the saved count n (the caller then writes the saved particles into them).
+	void restoreRemoved(const std::vector<RemovedParticle<D>>& recs, size_t n)
+	{
+		if (liveViews) throw InputError("checkpoint: delete the NumPy views of the particle arrays first (the particle count changes)");
+		if (n > P.n) throw InputError("checkpoint: " + std::to_string(n) + " particles saved, the scene has " + std::to_string(P.n));
+		RemovedAccount<D> acc;
+		for (const auto& r : recs) {
+			if (r.face < 0 || r.face >= 2 * D || !(r.mass > 0) || r.material >= materials.size())
+				throw InputError("checkpoint: removed particle id " + std::to_string(r.id) + " has an invalid face, mass or material");
+			acc.add(r);
+		}
+		if (n < P.n) {
+			dropScratch.assign(P.n, 0);
+			for (size_t p = n; p < P.n; ++p) dropScratch[p] = 1;
+			P.compact(dropScratch);
+			needSort = needCheck = true;
+		}
+		removed = recs, removedSum = acc;
+	}
 
 	// Checkpoint access (py/yade_mpm/checkpoint.py): with the particle arrays in storage order and the
 	// block schedule, these are everything the next step reads, so a resumed run is bitwise identical.
@@ -226,6 +253,69 @@ private:
 	Real             vmax = 0, rhoMin = INFINITY, massFloor = 0;
 	ErrorRecord      errP2G, errContact, errG2P; // shared by the threads of the transfer region
 	std::string      failure;                    // message of a step that failed with particles partly updated
+	std::vector<RemovedParticle<D>> removed;     // particles taken out after leaving the grid (outside policy)
+	RemovedAccount<D>               removedSum;
+	BodyClusters<D>                 clusters;    // debris or body (outside = 'remove-debris'), work arrays kept
+	std::vector<uint8_t>            dropScratch;
+
+	// End of a step in which particles left the grid (e.left, this rank's; MPI: every rank calls it when any
+	// rank has some). outside = 'stop', or a particle of the body under 'remove-debris': the run stops with the
+	// message naming the lowest such slot. Otherwise the particles are recorded, added to the account and
+	// taken out of the arrays (the block schedule keeps the others' order), and Δt's limits are refreshed.
+	void settleLeaving(ErrorRecord& e, Real dt)
+	{
+		auto& left = e.left;
+		std::sort(left.begin(), left.end()); // the threads filled it in any order
+		std::vector<int> reason(left.size(), 0);
+		size_t           stopAt = SIZE_MAX;
+		if (outside == OutsidePolicy::Stop) {
+			if (!left.empty()) stopAt = left[0];
+		} else if (outside == OutsidePolicy::RemoveDebris) {
+			bool needBody = false; // is any leaving particle intact (D < 1)? then the clusters decide
+			for (size_t k = 0; k < left.size(); ++k) {
+				reason[k] = BodyClusters<D>::intact(P, left[k]) ? 2 : 1;
+				needBody  = needBody || reason[k] == 2;
+			}
+#ifdef MPM_MPI
+			needBody = !Comm::all(!needBody); // every rank builds the map if one rank needs it (a collective)
+#endif
+			if (needBody) {
+				clusters.mark(grid, P);
+				MPM_IF_MPI(if (dd.distributed()) Comm::maxBytes(clusters.occupied.data(), clusters.occupied.size());)
+				clusters.labelClusters(grid);
+				for (size_t k = 0; k < left.size() && stopAt == SIZE_MAX; ++k)
+					if (reason[k] == 2 && !clusters.detached(grid, P, left[k])) stopAt = left[k];
+			}
+		}
+		bool stop = stopAt != SIZE_MAX;
+#ifdef MPM_MPI
+		if (!Comm::all(!stop) && !stop)
+			e.record(ErrorRecord::elsewhere, "stopped: a particle of the body left the grid on another MPI rank (its message names the particle)"), stop = true;
+#endif
+		if (stop) {
+			if (stopAt != SIZE_MAX) {
+				std::string hint = outside == OutsidePolicy::Stop
+				                           ? " (outside = 'stop')"
+				                           : "; it is intact material of the body (D < 1, in the largest connected cluster of intact material), so the grid "
+				                             "is too small for the body: enlarge the grid, or set outside = 'remove' to remove any particle that leaves";
+				e.record(stopAt, leftGridMessage(P, grid, stopAt) + hint);
+			}
+			throwIf(e, "position update", true);
+		}
+		dropScratch.assign(P.n, 0);
+		for (size_t k = 0; k < left.size(); ++k) {
+			const size_t       p = left[k];
+			RemovedParticle<D> r {};
+			r.id = P.id[p], r.step = steps + 1, r.time = time + dt;
+			for (int a = 0; a < D; ++a) r.x[a] = P.x[a][p], r.v[a] = P.v[a][p];
+			r.mass = P.mass[p], r.damage = P.hasDamageState() ? P.damage[p] : 0.0;
+			r.face = exitFace(P, grid, p), r.material = P.mat[p], r.reason = reason[k];
+			removed.push_back(r), removedSum.add(r);
+			dropScratch[p] = 1;
+		}
+		if (!left.empty()) P.compact(dropScratch), sched.dropSlots(dropScratch);
+		needCheck = true; // ρ_min, max ‖v‖ and the mass floor of the particles left (prepare; MPI: every rank takes part)
+	}
 
 	// After a failure in a phase that had already changed particles (partly), the state is not one of
 	// the scheme's states: further steps are refused until a checkpoint is restored (setResumeState).

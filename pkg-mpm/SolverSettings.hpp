@@ -4,6 +4,18 @@
 #pragma once
 #include "ParamTable.hpp"
 
+namespace mpm {
+// What happens to a particle that leaves the grid (the position update takes it past the grid's edge; crossing a
+// boundary plane is always an error). doc/algorithm.md, "Material that leaves the grid".
+enum class OutsidePolicy : int {
+	Stop         = 0, // stop the run with a SimulationError naming the particle, the face and the position
+	Remove       = 1, // remove every particle that leaves; its mass, momentum and kinetic energy go to the removed account
+	RemoveDebris = 2  // remove debris (damage D = 1, or detached from the body: not in the largest connected
+	                  // cluster of intact material); stop when intact material of the body reaches the edge
+};
+MPM_CHOICES(OutsidePolicy, "stop|remove|remove-debris")
+} // namespace mpm
+
 // X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate); Vec = Dim<D>::Vec (per component)
 #define MPM_SOLVER_SETTINGS(X)                                                                                                    \
 	X(Vec, gravity, 0, "m/s²", -INFINITY, INFINITY, OO, "g", "gravitational acceleration", "Eq. 22", "")                        \
@@ -16,7 +28,10 @@
 	X(int, sortPeriod, 50, "steps", 1, 1e9, CC, "", "re-sort particles by block at least every this many steps", "", "")        \
 	X(Real, mpiRebalance, 1.1, "-", 1, INFINITY, CC, "", "MPI only: at each re-sort, cut the slabs again when the busiest rank holds more " \
 	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
-	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")
+	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
+	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
+	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \
+	  "removed particles are accounted in Solver.removedAccount()", "", "")
 
 #define MPM_SOLVER_PARAMS(X) MPM_SOLVER_SETTINGS(X) MPM_SOLVER_STATE(X)
 

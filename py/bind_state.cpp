@@ -89,6 +89,84 @@ struct StateWrap {
 		s.setResumeState(r, std::vector<uint32_t>(p, p + a.shape(0)));
 	}
 
+	// ---- material that left the grid (Solver.outside; pkg-mpm/Removal.hpp) ----
+	template <class T>
+	static np::ndarray column(const std::vector<RemovedParticle<D>>& rs, T (*get)(const RemovedParticle<D>&))
+	{
+		np::ndarray a = np::empty(bp::make_tuple(rs.size()), np::dtype::get_builtin<T>());
+		T*          d = reinterpret_cast<T*>(a.get_data());
+		for (size_t k = 0; k < rs.size(); ++k) d[k] = get(rs[k]);
+		return a;
+	}
+	static np::ndarray vectors(const std::vector<RemovedParticle<D>>& rs, bool vel)
+	{
+		np::ndarray a = np::empty(bp::make_tuple(rs.size(), D), np::dtype::get_builtin<double>());
+		double*     d = reinterpret_cast<double*>(a.get_data());
+		for (size_t k = 0; k < rs.size(); ++k)
+			for (int c = 0; c < D; ++c) d[k * D + c] = vel ? rs[k].v[c] : rs[k].x[c];
+		return a;
+	}
+	// The removed particles of this solver (MPI: of this rank), in removal order, as arrays.
+	static bp::dict removedParticles(const S& s)
+	{
+		const auto& rs = s.removedParticles();
+		bp::dict    d;
+		d["id"]       = column<int64_t>(rs, [](const RemovedParticle<D>& r) { return r.id; });
+		d["step"]     = column<int64_t>(rs, [](const RemovedParticle<D>& r) { return int64_t(r.step); });
+		d["time"]     = column<double>(rs, [](const RemovedParticle<D>& r) { return r.time; });
+		d["pos"]      = vectors(rs, false);
+		d["vel"]      = vectors(rs, true);
+		d["mass"]     = column<double>(rs, [](const RemovedParticle<D>& r) { return r.mass; });
+		d["damage"]   = column<double>(rs, [](const RemovedParticle<D>& r) { return r.damage; });
+		d["face"]     = column<int32_t>(rs, [](const RemovedParticle<D>& r) { return int32_t(r.face); });
+		d["material"] = column<uint8_t>(rs, [](const RemovedParticle<D>& r) { return r.material; });
+		d["reason"]   = column<int32_t>(rs, [](const RemovedParticle<D>& r) { return int32_t(r.reason); });
+		return d;
+	}
+	static void restoreRemoved(S& s, bp::dict d, long n)
+	{
+		if (n < 0) throw InputError("checkpoint: particles = " + std::to_string(n) + " must be ≥ 0");
+		const long k = long(bp::len(d["id"]));
+		auto col = [&](const char* name, int cols) { return asDoubleArray(d[name], name, cols, size_t(k)); };
+		np::ndarray id = np::from_object(d["id"], np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
+		np::ndarray x = col("pos", D), v = col("vel", D), t = col("time", 0), m = col("mass", 0), dmg = col("damage", 0);
+		np::ndarray st = col("step", 0), f = col("face", 0), mt = col("material", 0), rs = col("reason", 0);
+		std::vector<RemovedParticle<D>> recs; recs.resize(size_t(k));
+		auto at = [](const np::ndarray& a, long i) { return reinterpret_cast<const double*>(a.get_data())[i]; };
+		for (long i = 0; i < k; ++i) {
+			auto& r = recs[size_t(i)];
+			r.id = reinterpret_cast<const int64_t*>(id.get_data())[i];
+			r.step = long(at(st, i)), r.time = at(t, i), r.mass = at(m, i), r.damage = at(dmg, i);
+			r.face = int(at(f, i)), r.material = uint8_t(at(mt, i)), r.reason = int(at(rs, i));
+			for (int c = 0; c < D; ++c) r.x[c] = at(x, i * D + c), r.v[c] = at(v, i * D + c);
+		}
+		s.restoreRemoved(recs, size_t(n));
+	}
+	// The running account of the removed particles (MPI: over every rank, a collective).
+	static bp::dict removedAccount(const S& s)
+	{
+		const auto& a = s.removedAccount();
+		constexpr int nv = 3 + D + 2 * D;
+		double v[nv], last[2] = { a.lastTime, double(a.lastStep) };
+		v[0] = double(a.count), v[1] = a.mass, v[2] = a.kinetic;
+		for (int c = 0; c < D; ++c) v[3 + c] = a.momentum[c];
+		for (int f = 0; f < 2 * D; ++f) v[3 + D + f] = double(a.faces[f]);
+#ifdef MPM_MPI
+		std::vector<double> scratch;
+		Comm::sumInRankOrder(v, nv, scratch), Comm::max(last, 2);
+#endif
+		bp::dict d, faces;
+		d["count"] = long(v[0]), d["mass"] = v[1], d["kinetic_energy"] = v[2];
+		bp::list mom;
+		for (int c = 0; c < D; ++c) mom.append(v[3 + c]);
+		d["momentum"] = bp::tuple(mom);
+		for (int f = 0; f < 2 * D; ++f) faces[faceName(f)] = long(v[3 + D + f]);
+		d["faces"] = faces;
+		d["last_time"] = long(v[0]) ? bp::object(last[0]) : bp::object();
+		d["last_step"] = long(v[0]) ? bp::object(long(last[1])) : bp::object();
+		return d;
+	}
+
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
 		ParamBinding<S>::exposeProperties(cls); // settings and writable state, checked (SolverSettings.hpp)
@@ -97,7 +175,15 @@ struct StateWrap {
 		        .def("phaseTimes", &phaseTimes)
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("getResumeState", &getResumeState)
-		        .def("setResumeState", &setResumeState, bp::arg("state"));
+		        .def("setResumeState", &setResumeState, bp::arg("state"))
+		        .def("removedAccount", &removedAccount,
+		             "What left the grid and was removed (Solver.outside): {count, mass [kg], momentum (Σ m v) [kg·m/s], kinetic_energy [J], "
+		             "last_time [s], last_step, faces: {'x-': n, 'x+': n, …}}; MPI: over every rank (a collective).")
+		        .def("removedParticles", &removedParticles,
+		             "The removed particles in removal order as arrays: id, step, time [s], pos [m], vel [m/s] (at removal), mass [kg], damage, "
+		             "face (2·axis + 1 for the upper end), material, reason (0 outside = 'remove', 1 fully damaged, 2 detached); MPI: this rank's.")
+		        .def("_restoreRemoved", &restoreRemoved, (bp::arg("removed"), bp::arg("particles")),
+		             "Checkpoint resume: the removed particles, and the particle arrays cut to the saved count (yade_mpm.checkpoint).");
 	}
 };
 } // namespace

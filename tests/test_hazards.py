@@ -129,10 +129,10 @@ def test_solver_settings_declared_once_with_unit_range_and_doc():
     """Settings are generated from one declaration (SolverSettings.hpp): each property's docstring
     carries its unit and range, and bad values are refused with the name and the range."""
     names = set(_scene().settings())
-    assert names == {"gravity", "damping", "courant", "autoDt", "fixedDt", "tractionRampTime", "sortPeriod", "mpiRebalance", "trackEnergy"}
+    assert names == {"gravity", "damping", "courant", "autoDt", "fixedDt", "tractionRampTime", "sortPeriod", "mpiRebalance", "trackEnergy", "outside"}
     for n in names | {"time", "externalWork"}:
         doc = getattr(ym.Solver2D, n).__doc__
-        assert "[" in doc and ("range" in doc or "True or False" in doc), n
+        assert "[" in doc and ("range" in doc or "True or False" in doc or "one of" in doc), n
     s = _scene()
     for name, bad, msg in (("sortPeriod", 0, r"Solver2D.sortPeriod = 0 \[steps\] is outside the allowed range \[1, 1000000000\]"),
                            ("courant", 1.5, r"Solver2D.courant = 1.5 \[-\] is outside the allowed range \(0, 1\]"),

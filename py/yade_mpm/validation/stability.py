@@ -5,7 +5,8 @@ coarse versions; doc/stability.md has the results).
 Cases: stiff (E = 200 GPa), nearly incompressible (ν = 0.49), very soft (E = 1 MPa), traction ramped
 at a baseline quasi-static rate and 100× faster, a column collapsing under gravity (large plastic
 deformation), fully damaged regions under tension, particles reaching the grid edge, and particles of
-density 1 and 1e7 kg/m³ side by side.
+density 1 and 1e7 kg/m³ side by side; debris thrown off the grid (a fragment at 5–200 m/s, a layer torn off
+by tension).
 
 Every step of every case is checked for
   * non-finite particle state (position, velocity, stress, volume, damage) or energy,
@@ -15,9 +16,14 @@ Every step of every case is checked for
     automatic Δt uses, so the check can fail); the paper's condition Δt ≤ l/(v_c + max‖v‖) (C = 1)
     re-evaluated with the velocities after the step is reported as well
     (max_dt_over_paper_limit_after_step).
-A case passes only with its expected outcome: it finishes, or (the overload and grid-edge cases) the
-solver stops it with MpmSimulationError, whose message must name the step, the particle id and the
-offending quantity. A case expected to finish that is stopped by an error has failed.
+A case passes only with its expected outcome: it finishes, or (the grid-edge case: the intact body itself
+reaches the edge of the grid) the solver stops it with MpmSimulationError, whose message must name the
+step, the particle id and the offending quantity. A case expected to finish that is stopped by an error
+has failed. Debris cases (a fully damaged fragment thrown at the grid edge at 5 to 200 m/s, a layer torn
+off by tension) must finish with the debris removed (Solver.outside = 'remove-debris', the default): the
+number of removed particles is part of the expected outcome (none for every other case), the energy bound
+counts the kinetic energy of what was removed and, without gravity and walls, the momentum of the
+particles plus that of the removed ones must stay the initial momentum.
 """
 import math
 import time
@@ -116,13 +122,15 @@ def case_rate_100x(fast):
 def case_overload(fast):
     """DP–GK rock hit by a 200 MPa top compression applied at once (no ramp), ≈ 2.2× the rock's
     Mohr–Coulomb uniaxial strength 2c·cosφ/(1 − sinφ) ≈ 90 MPa: the block is crushed, a loaded top corner
-    particle is squeezed out sideways and leaves the grid (2 margin cells on the left), which must stop the
-    run with the grid-edge message."""
+    particle is squeezed out sideways and leaves the grid (2 margin cells on the left): intact material of
+    the body reaching the edge, which must stop the run with the grid-edge message (fully damaged or
+    detached debris of the crushed corner that leaves first is removed)."""
     mat = rocks.granite_dpgk()
     s, _, h = block_on_floor(mat, 1.0, cells_per_m(fast), extra_x=0.5, extra_y=0.5)
     s.gravity = (0.0, -9.81)
     top_traction(s, h, 2, -200e6, 0.0)
-    return s, dict(end_time=20 * transit_time(mat, 1.0), expect="stopped_with_error")
+    # debris of the crushed corner (D = 1, or detached) may be removed before the intact corner leaves
+    return s, dict(end_time=20 * transit_time(mat, 1.0), expect="stopped_with_error", removed=("any", None))
 
 
 def case_column_collapse(fast):
@@ -166,6 +174,62 @@ def case_grid_edge(fast):
     s.view("v0")[:] = 100.0
     s.requestSort()
     return s, dict(end_time=1.0, expect="stopped_with_error")
+
+
+# Debris: a detached, fully damaged 2 × 2-cell fragment thrown at the grid edge beside an intact block
+# (Solver.outside at its default 'remove-debris'). The block [0, 0.3]² m carries a converging velocity
+# field (a compression wave, ≤ 0.2 m/s); the fragment starts at x = 0.46 m, 0.16 m from the block, and is
+# thrown towards +x. No gravity, no walls: the momentum of the particles plus that of the removed ones is
+# the initial momentum.
+DEBRIS_SPEEDS = (5.0, 20.0, 50.0, 200.0)
+DEBRIS_FRAGMENT_LO = (0.46, 0.12)
+
+
+def debris_scene(speed, fragment=True, fast=True):
+    """The block and (fragment=True) the fragment thrown at `speed` [m/s] towards +x; returns
+    (solver, block ids, fragment ids). Grid spacing 20 mm (fast) or 10 mm, 2 margin cells."""
+    h = 0.02 if fast else 0.01
+    s = make_solver((0.0, 0.0), (0.5, 0.4), h, margin=2)
+    rock = rocks.granite_dpgk()
+    block = add_region(s, rock, (0.0, 0.0), (0.3, 0.3), ppc=2)
+    lo = DEBRIS_FRAGMENT_LO
+    frag = add_region(s, rock, lo, (lo[0] + 2 * h, lo[1] + 2 * h), ppc=2) if fragment else np.zeros(0, dtype=np.int64)
+    x, v0, ids = s.view("x0"), s.view("v0"), s.view("id")
+    v0[:] = 0.2 * (0.15 - x) / 0.15
+    f = np.isin(ids, frag)
+    v0[f] = speed
+    s.view("damage")[f] = 1.0                 # fully damaged: debris
+    del x, v0, ids
+    s.requestSort()
+    return s, np.asarray(block), np.asarray(frag)
+
+
+def debris_end_time(fast=True):
+    """Long enough for every fragment particle to leave the grid at 5 m/s."""
+    return 0.02
+
+
+def _debris_case(speed):
+    def build(fast):
+        s, _, _ = debris_scene(speed, fast=fast)
+        return s, dict(end_time=debris_end_time(fast), expect="finished", removed=("count", 16), momentum=True)
+    build.__doc__ = f"Fragment (D = 1, 2 × 2 cells) thrown at {speed:g} m/s at the grid edge beside an intact block: removed, the run goes on."
+    return build
+
+
+def case_layer_torn_off(fast):
+    """Rock block [0, 0.4]² m whose top 60 mm (y > 0.34 m) are launched upwards at 30 m/s: the
+    tensile wave from the velocity jump (≈ ρ c_p Δv/2 ≈ 120 MPa) damages the rows beneath them, the
+    layer tears off and flies through the top of the grid (4 margin cells). The layer is debris (detached
+    from the body, or D = 1) and is removed; the block stays. No gravity, no walls: momentum conserved."""
+    h = 0.04 if fast else 0.01
+    s = make_solver((0.0, 0.0), (0.4, 0.4), h, margin=4)
+    add_region(s, rocks.granite_dpgk(), (0.0, 0.0), (0.4, 0.4), ppc=2)
+    y = s.view("x1")
+    s.view("v1")[y > 0.34] = 30.0
+    del y
+    s.requestSort()
+    return s, dict(end_time=0.02, expect="finished", removed=("some", None), momentum=True)
 
 
 def case_mass_contrast(fast):
@@ -222,7 +286,10 @@ CASES = {
     "overload_step": (case_overload, "DP–GK rock, 200 MPa top compression applied at once: crushed"),
     "column_collapse": (case_column_collapse, "DP column (c = 100 Pa, φ = 30°) collapsing under gravity"),
     "fully_damaged": (case_damaged, "DP–GK rock, D = 1 band, upper half launched up at 10 m/s"),
-    "grid_edge": (case_grid_edge, "block at 100 m/s towards the grid edge, no walls"),
+    "grid_edge": (case_grid_edge, "intact block at 100 m/s towards the grid edge, no walls: the body leaves, the run stops"),
+    **{f"debris_{v:g}ms": (_debris_case(v), f"D = 1 fragment thrown at {v:g} m/s at the grid edge beside a block: removed")
+       for v in DEBRIS_SPEEDS},
+    "layer_torn_off": (case_layer_torn_off, "top layer torn off by tension (launched at 30 m/s): removed as debris"),
     "edge_deforming": (case_edge_deforming, "rock block filling the grid to its edges, 20 MPa fast compression"),
     "mass_contrast": (case_mass_contrast, "densities 1 and 1e7 kg/m³ side by side under gravity"),
     "mass_stacked": (case_mass_stacked, "1e7 kg/m³ half resting on a 1 kg/m³ half under gravity"),
@@ -263,6 +330,32 @@ def error_is_clear(msg):
             and any(q in msg for q in ("left the grid", "stress", "velocity", "volume", "position", "WLS")))
 
 
+# Momentum balance of the cases without gravity and walls: |Σ m v + p_removed − p0| ≤ MOMENTUM_TOL × Σ m‖v‖
+# (roundoff of the nodal sums; measured ~1e-15).
+MOMENTUM_TOL = 1e-10
+
+
+def _momentum(s):
+    m = s.view("mass")
+    return np.array([float(np.sum(m * s.view(f"v{a}"))) for a in range(dim_of(s))])
+
+
+def _removed_expectation(spec):
+    if spec is None:
+        return "none"
+    kind, n = spec
+    return {"count": f"exactly {n}", "some": "at least one", "any": "any number"}[kind]
+
+
+def _removed_as_expected(spec, count):
+    """Removed-particle count against a case's expectation: None = none may leave (removal would hide a
+    failure), ('count', n) exactly n, ('some', None) at least one, ('any', None) any number."""
+    if spec is None:
+        return count == 0
+    kind, n = spec
+    return count == n if kind == "count" else count > 0 if kind == "some" else True
+
+
 def paper_dt_limit(s):
     """l/(v_c + max‖v‖) of the paper's stability condition from the particle arrays and the material,
     independently of the solver's cached ρ_min and max speed: v_c = √((K + 4G/3)/ρ_min)."""
@@ -280,6 +373,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
     end_time, expect = opts["end_time"], opts.get("expect", "finished")
     s.trackEnergy = True
     e0 = s.kineticEnergy() + s.elasticEnergy()
+    p0 = _momentum(s)
     hist = {"t": [], "total": [], "input": [], "dt_ratio": [], "dt_ratio_paper": []}
     outcome, message, nan_seen = "finished", "", False
     limit = [None]
@@ -291,7 +385,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
     def check(s):
         nonlocal nan_seen, outcome, message
         after = paper_dt_limit(s)  # paper's Δt ≤ l/(v_c+|v|), C = 1, after the step
-        tot = s.kineticEnergy() + s.elasticEnergy()
+        tot = s.kineticEnergy() + s.elasticEnergy() + s.removedAccount()["kinetic_energy"]   # what left the grid counts
         hist["t"].append(s.time)
         hist["total"].append(tot)
         hist["input"].append(e0 + s.externalWork)
@@ -338,6 +432,20 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
         "message": message,
         "error_message_clear": bool(error_is_clear(message)) if outcome == "stopped_with_error" else None,
     }
+    acc = s.removedAccount()
+    summary["removed_particles"] = int(acc["count"])
+    summary["removed_mass_kg"] = float(acc["mass"])
+    summary["removed_kinetic_energy_J"] = float(acc["kinetic_energy"])
+    summary["removed_faces"] = {k: v for k, v in acc["faces"].items() if v}
+    summary["removed_expected"] = _removed_expectation(opts.get("removed"))
+    removed_ok = _removed_as_expected(opts.get("removed"), int(acc["count"]))
+    if opts.get("momentum"):                  # no gravity, no walls: Σ m v + removed momentum = initial momentum
+        p1 = _momentum(s) + np.asarray(acc["momentum"])
+        scale = max(float(np.sum(s.view("mass") * np.sqrt(sum(s.view(f"v{a}") ** 2 for a in range(dim_of(s)))))) + float(np.linalg.norm(acc["momentum"])),
+                    float(np.linalg.norm(p0)), 1e-300)
+        summary["momentum_error_rel"] = float(np.linalg.norm(p1 - p0) / scale)
+        summary["momentum_conserved"] = bool(summary["momentum_error_rel"] <= MOMENTUM_TOL)
+    momentum_ok = summary.get("momentum_conserved", True)
     if s.materialKind == 1:
         d = s.view("damage")
         summary["fraction_fully_damaged"] = float(np.mean(d >= 1.0))
@@ -345,7 +453,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
     # Passed only with the expected outcome: a case expected to finish that the solver stopped has FAILED;
     # a case built to overload or leave the grid must be stopped, with a clear message.
     outcome_ok = outcome == expect
-    summary["passed"] = bool(outcome_ok and not nan_seen and summary["energy_bounded"] and dt_ok
+    summary["passed"] = bool(outcome_ok and not nan_seen and summary["energy_bounded"] and dt_ok and removed_ok and momentum_ok
                              and (outcome != "stopped_with_error" or summary["error_message_clear"]))
     hist["ratio"] = ratio
     hist["pos"] = get(s, "pos")
