@@ -21,7 +21,7 @@ from . import _core
 _guards.install(_core)      # Solver.view("id") read-only, Solver.reserve(n) checked against the memory
 _guards.cap_core_threads(_core)
 from .materials import ElasticMat, DpGkMat
-from .fields import get, fields, FIELDS, id_order, views, SYM_NAMES
+from .fields import get, fields, FIELDS, id_order, views, removed, SYM_NAMES
 from .scene import (check_setting, setting_default, courant_option, check_courant, make_solver, add_region, set_initial_stress, boundary_particles, apply_traction,
                     apply_face_traction, consistent_row_weights)
 from .geometry import Circle, Box, Disc, Polygon, rotated_rectangle, fill_region
@@ -34,7 +34,7 @@ from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene buil
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
-           "check_setting", "setting_default", "courant_option", "check_courant", "make_solver", "add_region", "views", "get", "id_order", "set_initial_stress", "boundary_particles",
+           "check_setting", "setting_default", "courant_option", "check_courant", "make_solver", "add_region", "views", "get", "id_order", "removed", "set_initial_stress", "boundary_particles",
            "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Disc", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "ContactParams", "contact_params", "DemSpheres",
            "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
            "dpgkThresholdScale"]

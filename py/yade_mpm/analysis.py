@@ -201,13 +201,14 @@ def region_test(region, name="region"):
 
 def softening_end(solver, order=None):
     """Per particle (id order, or `order`): the accumulated plastic strain ε̄p at which the DP–GK
-    cohesion reaches its floor, (1 − c_r)·ε̄p_crit (Eq. 34); inf for particles of other materials."""
-    from .fields import id_order
+    cohesion reaches its floor, (1 − c_r)·ε̄p_crit (Eq. 34); inf for particles of other materials, NaN for
+    removed ones (rows as ``fields.get``)."""
+    from .fields import id_order, _with_removed_rows
     kinds = solver.materialKinds
     mats = [solver.material(i) for i in range(solver.numMaterials)]
     end = np.array([(1 - m.residualCohesion) * m.critPlasticStrain if k == 1 else np.inf for m, k in zip(mats, kinds)])
     o = id_order(solver) if order is None else order
-    return end[solver.view("material")[o].astype(np.int64)]
+    return _with_removed_rows(solver, "softening_end", end[solver.view("material")[o].astype(np.int64)], o)
 
 
 def failed(damage, plastic_strain, soft_end):

@@ -34,9 +34,9 @@ from . import _core
 from .engine import MpmEngine, _registry as _engines
 from .fields import SYM_NAMES, dim_of
 
-# 4: contact parameters (ContactParams.toDict) in the fingerprint; 3: named material options as words;
+# 5: the particles removed after leaving the grid (Solver.outside) and their account; 4: contact parameters (ContactParams.toDict) in the fingerprint; 3: named material options as words;
 # 2: solver settings as Solver.settings() in the header (1: a hand-written list)
-FORMAT = 4
+FORMAT = 5
 MAGIC = b"YADE-MPM-CHECKPOINT\n"
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
 
@@ -119,8 +119,13 @@ def solver_fingerprint(solver, ids=None):
             "material_index": _digest(arrs["material"][order])}
 
 
+_REMOVED = ("id", "step", "time", "pos", "vel", "mass", "damage", "face", "material", "reason")
+
+
 def _solver_state(solver):
     arrs = {k: np.array(v, copy=True) for k, v in _particle_arrays(solver).items()}
+    for k, v in solver.removedParticles().items():   # particles removed after leaving the grid (this rank's)
+        arrs[f"removed_{k}"] = np.array(v, copy=True)
     rs = solver.getResumeState()
     arrs["blockStart"] = np.array(rs["blockStart"], copy=True)
     arrs["scalars"] = np.array([float(rs[k]) for k in _STATE_SCALARS], dtype=np.float64)
@@ -136,6 +141,8 @@ def _restore_solver(solver, arrs, settings):
     for k in ("needSort", "needCheck"):
         sc[k] = bool(sc[k])
     sc["blockStart"] = arrs["blockStart"]
+    # the removed particles and their account; the fresh scene's arrays cut to the saved particle count
+    solver._restoreRemoved({k: arrs[f"removed_{k}"] for k in _REMOVED}, len(arrs["id"]))
     views = _particle_arrays(solver)
     for k in views:                               # shapes were checked before anything was changed
         if views[k].shape != arrs[k].shape:
@@ -236,6 +243,7 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
                           "meta": meta, "extra": extra, "solvers": {}, "settings": {}, "yade": None}
     if mpi:
         header["mpi"] = {name: cmpi.header_of(s) for name, s in sol.items()}   # a collective: every rank saves
+    header["removed"] = {name: int(s.removedAccount()["count"]) for name, s in sol.items()}   # MPI: over the ranks
     for name, s in sol.items():
         header["solvers"][name] = solver_fingerprint(s)
         header["settings"][name] = s.settings()   # JSON floats round-trip exactly
@@ -384,9 +392,14 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
         raise ValueError("solvers must be None, a Solver2D/3D or a {name: solver} dict")
     problems = []
     for n, s in sol.items():
-        ids = arrays[f"solver/{n}/id"] if mpi else None          # MPI: this rank's particles of the fresh scene
-        if mpi and mpi[n]["total"] != s.numParticles:
-            problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks in the checkpoint, {s.numParticles} in this scene")
+        gone = int(header.get("removed", {}).get(n, 0))          # particles removed after leaving the grid
+        # MPI: this rank's particles of the fresh scene; after removals: the particles still in the computation
+        ids = arrays[f"solver/{n}/id"] if (mpi or gone) else None
+        if mpi and mpi[n]["total"] + gone != s.numParticles:
+            problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
+                            f"{s.numParticles} in this scene")
+        if not mpi and gone and len(ids) + gone != s.numParticles:
+            problems.append(f"solver {n}: {len(ids)} particles and {gone} removed in the checkpoint, {s.numParticles} in this scene")
         try:
             problems += _diff(header["solvers"][n], solver_fingerprint(s, ids), f"solver {n}: ")
         except CheckpointError as e:

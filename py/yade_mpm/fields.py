@@ -6,6 +6,13 @@
 (damaged for DP–GK, Eq. 40), ``undamaged_stress`` the stress of the intact material that the
 constitutive update advances (equal to ``stress`` for elastic particles and for D = 0).
 
+Removed particles (``Solver.outside``: material that left the grid and was taken out of the computation)
+keep their ids and rows: every float field is NaN in a removed particle's row, ``id`` and ``material`` keep
+their values and the bool field ``removed`` is True there (N rows = particles added, removed or not; sum
+with ``np.nansum``, or select ``~f["removed"]``). ``removed(solver)`` lists their state at removal and the
+running account (count, mass, momentum, kinetic energy, faces). Under MPI each rank reads its own particles
+(no rows for removed ones).
+
 Power users: ``solver.view(name)`` and ``views(solver)`` are live NumPy views on the solver's own
 arrays (no copy, writable) under the core's short names (x0, v0, sig0.., epsP, vol …) in STORAGE
 order, which changes whenever the solver re-sorts its particles (every step may); ``view("id")``
@@ -37,6 +44,8 @@ FIELDS = {
     "mass": ("mass", "kg", "mass (per metre of thickness in 2D)"),
     "volume": ("vol", "m³", "current volume (m² × 1 m in 2D)"),
     "material": ("material", "-", "material index (solver.material(i))"),
+    "removed": ("removedParticles()", "-", "True for a particle removed after it left the grid (Solver.outside): its "
+                "rows of every float field are NaN, id and material keep their values; removed(solver) has its state at removal"),
 }
 _RENAMED = {"state_stress": "undamaged_stress", "sig": "stress' or 'undamaged_stress", "x": "pos", "v": "vel",
             "epsP": "plastic_strain", "vol": "volume", "position": "pos", "velocity": "vel"}
@@ -74,16 +83,74 @@ def id_order(solver):
     return np.argsort(solver.view("id"), kind="stable")
 
 
+def _removed_ids(solver):
+    """Ids of the removed particles of a one-process solver (None when there are none or under MPI, where
+    each rank reads only its own particles)."""
+    from .parallel import size
+    if solver.removedAccount()["count"] == 0 if size() == 1 else True:
+        return None
+    return solver.removedParticles()["id"]
+
+
+def _with_removed_rows(solver, name, live, order):
+    """Spreads the live particles' rows (id order) over all ids, removed ones included: NaN rows (float
+    fields), the id, the material index, the removed flag."""
+    gone = _removed_ids(solver)
+    if gone is None:
+        return live
+    ids = solver.view("id")[order]
+    total = len(ids) + len(gone)
+    if name == "id":
+        return np.arange(total, dtype=live.dtype)
+    if name == "removed":
+        out = np.zeros(total, dtype=bool)
+        out[gone] = True
+        return out
+    if name == "material":
+        out = np.empty(total, dtype=live.dtype)
+        out[ids] = live
+        out[gone] = solver.removedParticles()["material"]
+        return out
+    out = np.full((total,) + live.shape[1:], np.nan)
+    out[ids] = live
+    return out
+
+
+def removed(solver):
+    """What left the grid and was removed (``Solver.outside``): a dict with the running account — count,
+    mass [kg], momentum (Σ m v) [kg·m/s], kinetic_energy [J], last_time [s], last_step, faces {'x-': n, …} —
+    and 'particles', the removed particles in removal order: id, step, time [s], pos [m], vel [m/s] (at
+    removal), mass [kg], damage, face ('x+' …), material, reason ('remove', 'damaged' = D = 1, 'detached' =
+    not in the body's cluster). Under MPI the account is over every rank (a collective), the particles are
+    this rank's."""
+    d = dict(solver.removedAccount())
+    p = dict(solver.removedParticles())
+    dim = dim_of(solver)
+    p["face"] = np.array([f"{'xyz'[f // 2]}{'+' if f % 2 else '-'}" for f in p["face"]], dtype=f"<U2")
+    p["reason"] = np.array([("remove", "damaged", "detached")[r] for r in p["reason"]], dtype="<U8")
+    p["pos"], p["vel"] = p["pos"].reshape(-1, dim), p["vel"].reshape(-1, dim)
+    d["particles"] = p
+    return d
+
+
 def get(solver, name, order=None):
     """Copy of the particle field `name` in particle-id order (row k = particle id k). Names (``FIELDS``):
     id, pos, vel [m, m/s] (of the material point), momentum [kg·m/s] (sums to the total exactly), stress (carried, damaged for DP–GK) and undamaged_stress [Pa] (xx, yy, zz, xy[,
     xz, yz], tension positive), max_principal_stress [Pa], damage, plastic_strain, cohesion [Pa], mass
-    [kg], volume [m³], material. Pass order=id_order(solver) when reading several fields of one state."""
+    [kg], volume [m³], material, removed (True for a particle removed after it left the grid: NaN in its
+    rows of the float fields). Pass order=id_order(solver) when reading several fields of one state."""
     d = dim_of(solver)
     if name not in FIELDS:
         hint = f" (use '{_RENAMED[name]}')" if name in _RENAMED else ""
         raise ValueError(f"unknown field {name!r}{hint}; fields: {', '.join(FIELDS)}")
     o = id_order(solver) if order is None else order
+    return _with_removed_rows(solver, name, _get_live(solver, name, o, d), o)
+
+
+def _get_live(solver, name, o, d):
+    """Field `name` of the particles in the computation, in id order (storage slots o)."""
+    if name == "removed":
+        return np.zeros(len(o), dtype=bool)
     if name == "pos":
         return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
     if name == "vel":
@@ -100,7 +167,7 @@ def get(solver, name, order=None):
         try:
             return solver.view(FIELDS[name][0])[o].copy()
         except ValueError:                       # not allocated: no DP–GK material in the scene
-            return np.zeros(solver.numParticles)
+            return np.zeros(len(o))
     if name == "cohesion":
         if 1 not in solver.materialKinds:
             raise ValueError("cohesion exists only for the DP–GK material")

@@ -106,6 +106,10 @@ def particle_fields(solver, x0=None):
         # shear crack = plastic strain past the softening end (cohesion at its 0.1 c0 floor), per material
         fields["tensile_crack"] = (fields["damage"] >= 1.0).astype(np.int64)
         fields["shear_crack"] = (fields["plastic_strain"] >= softening_end(solver, order)).astype(np.int64)
+    gone = field("removed")
+    if gone.any():                                # particles removed after leaving the grid are left out
+        keep = ~gone
+        pos, fields = pos[keep], {k: v[keep] for k, v in fields.items()}
     return pos, fields
 
 
