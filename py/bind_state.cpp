@@ -143,8 +143,9 @@ struct StateWrap {
 		s.restoreRemoved(recs, size_t(n));
 	}
 	// The running account of the removed particles (MPI: over every rank, a collective).
-	static bp::dict removedAccount(const S& s)
+	static bp::dict removedAccount(const S& s, bool allRanks)
 	{
+		(void)allRanks;
 		const auto& a = s.removedAccount();
 		constexpr int nv = 3 + D + 2 * D;
 		double v[nv], last[2] = { a.lastTime, double(a.lastStep) };
@@ -153,7 +154,7 @@ struct StateWrap {
 		for (int f = 0; f < 2 * D; ++f) v[3 + D + f] = double(a.faces[f]);
 #ifdef MPM_MPI
 		std::vector<double> scratch;
-		Comm::sumInRankOrder(v, nv, scratch), Comm::max(last, 2);
+		if (allRanks) Comm::sumInRankOrder(v, nv, scratch), Comm::max(last, 2);
 #endif
 		bp::dict d, faces;
 		d["count"] = long(v[0]), d["mass"] = v[1], d["kinetic_energy"] = v[2];
@@ -176,9 +177,9 @@ struct StateWrap {
 		        .def("resetPhaseTimes", &resetPhaseTimes)
 		        .def("getResumeState", &getResumeState)
 		        .def("setResumeState", &setResumeState, bp::arg("state"))
-		        .def("removedAccount", &removedAccount,
+		        .def("removedAccount", &removedAccount, (bp::arg("allRanks") = true),
 		             "What left the grid and was removed (Solver.outside): {count, mass [kg], momentum (Σ m v) [kg·m/s], kinetic_energy [J], "
-		             "last_time [s], last_step, faces: {'x-': n, 'x+': n, …}}; MPI: over every rank (a collective).")
+		             "last_time [s], last_step, faces: {'x-': n, 'x+': n, …}}; MPI: over every rank (a collective), or this rank's with allRanks=False.")
 		        .def("removedParticles", &removedParticles,
 		             "The removed particles in removal order as arrays: id, step, time [s], pos [m], vel [m/s] (at removal), mass [kg], damage, "
 		             "face (2·axis + 1 for the upper end), material, reason (0 outside = 'remove', 1 fully damaged, 2 detached); MPI: this rank's.")

@@ -48,7 +48,8 @@ def run(a):
     if a.mode == "save":
         t = time.time(); s.run(a.steps); rec["steps_before_s"] = time.time() - t
         t = time.time(); checkpoint.save(ck, s); rec["save_s"] = time.time() - t
-        rec["piece_bytes"] = os.path.getsize(ck + f".r{rank}")
+        piece = ck + f".r{rank}"                   # N > 1 ranks: a piece per rank; one process: the file itself
+        rec["piece_bytes"] = os.path.getsize(piece if os.path.exists(piece) else ck)
     else:
         t = time.time(); checkpoint.load(ck, s); rec["load_s"] = time.time() - t
     t = time.time(); s.run(a.steps); rec["steps_after_s"] = time.time() - t

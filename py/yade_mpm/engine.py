@@ -94,4 +94,4 @@ class MpmEngine:
             print(f"[{self.label}] MPM stopped: {e}", flush=True)
             raise
         if self.progress:
-            self.progress.update(s.steps, s.time)
+            self.progress.update(s.steps, s.time, solver=s)

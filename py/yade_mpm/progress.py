@@ -5,7 +5,9 @@ import time
 
 class Progress:
     """Call ``update(step, t)`` as often as you like; prints at most every `interval` wall seconds.
-    The ETA comes from the fraction done of `end_time` [s] (simulated), or else of `total_steps`."""
+    The ETA comes from the fraction done of `end_time` [s] (simulated), or else of `total_steps`. With a
+    `solver` (set by ``runner.run``, or ``update(…, solver=s)``) a line also reports the particles removed
+    after leaving the grid (Solver.outside), once there are any: count and mass (this rank's under MPI)."""
 
     def __init__(self, end_time, label="mpm", interval=10.0, stream=sys.stdout, total_steps=None):
         from .geometry import _integer, _number
@@ -20,6 +22,7 @@ class Progress:
         self.start = time.time()
         self.last = self.start
         self.t0 = self.step0 = None
+        self.solver = None
 
     def fraction(self, step, t):
         """Fraction of the run done since the first update (None when neither end is known)."""
@@ -29,7 +32,9 @@ class Progress:
             return min(1.0, (step - self.step0) / self.total_steps)
         return None
 
-    def update(self, step, t, force=False):
+    def update(self, step, t, force=False, solver=None):
+        if solver is not None:
+            self.solver = solver
         now = time.time()
         if self.t0 is None:
             self.t0, self.step0 = t, step
@@ -40,5 +45,11 @@ class Progress:
         frac = self.fraction(step, t)
         eta = elapsed * (1 - frac) / frac if frac else float("nan")
         pct = f" ({100 * frac:5.1f} %)" if frac is not None else ""
-        print(f"[{self.label}] step {step:9d}  t = {t:.6e} s{pct}  wall {elapsed:7.1f} s  ETA {eta:7.1f} s",
+        print(f"[{self.label}] step {step:9d}  t = {t:.6e} s{pct}  wall {elapsed:7.1f} s  ETA {eta:7.1f} s{self._removed()}",
               file=self.stream, flush=True)
+
+    def _removed(self):
+        if self.solver is None:
+            return ""
+        acc = self.solver.removedAccount(allRanks=False)   # no collective: ranks print at their own times
+        return f"  removed {acc['count']} ({acc['mass']:.4g} kg)" if acc["count"] else ""

@@ -208,6 +208,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
     wall0 = _time.time()
     taken, reason = 0, None
     if prog is not None:
+        prog.solver = solver                      # its lines report the particles removed after leaving the grid
         prog.update(solver.steps, solver.time)    # the first update fixes where the ETA counts from
     for o in outs:
         o._begin(solver)

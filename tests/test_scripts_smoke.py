@@ -1,0 +1,107 @@
+"""Every script under scripts/ still runs: the scripts without a test of their own, each on a small case
+(one thread, a few seconds), checked for exit status 0 and the output it promises. Scripts tested
+elsewhere: tunnel_spalling, uniaxial_flaw, circular_opening, penny_crack (test_courant, test_tunnel_script,
+test_case_results …), stability, report, study_report, sweep, fidelity_variants, bench, bench_kernel,
+regress (test_bad_input), mpi_run.sh (test_mpi)."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPTS = os.path.join(ROOT, "scripts")
+
+
+def run(script, *args, env=None, timeout=300):
+    e = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"), **(env or {}))
+    r = subprocess.run([sys.executable, os.path.join(SCRIPTS, script), *map(str, args)], env=e, capture_output=True,
+                       text=True, timeout=timeout)
+    return r
+
+
+def ok(r):
+    assert r.returncode == 0, (r.stdout[-2000:], r.stderr[-3000:])
+    return r.stdout
+
+
+def test_compare_bonded_small(tmp_path):
+    """The MPM intact uniaxial run to 0.03 % strain and the Kirsch part on a 0.6 m block (three MPM grids, one
+    sphere size); summary.json with both parts and no stopped run."""
+    out = ok(run("compare_bonded.py", "--out", tmp_path, "--parts", "mpm_intact,kirsch", "--mpm-spacing", 0.0025,
+                 "--max-strain", 0.0003, "--kirsch-domain", 0.6, "--kirsch-mpm-spacing", 0.05, "--kirsch-dem-radii", 0.05))
+    s = json.load(open(tmp_path / "summary.json"))
+    assert s["stopped"] == [] and [r["method"] for r in s["kirsch"]] == ["mpm"] * 3 + ["jcfpm"]
+    assert (tmp_path / "mpm_intact.npz").exists() and "wrote" in out
+
+
+def test_compare_bonded_names_a_failed_run_and_goes_on(tmp_path):
+    """A part that fails (a grid spacing circular_opening.py refuses) is named in the summary and the exit
+    status; the other runs still ran."""
+    r = run("compare_bonded.py", "--out", tmp_path, "--parts", "kirsch", "--kirsch-domain", 0.6, "--kirsch-mpm-spacing", 0.04,
+            "--kirsch-dem-radii", 0.05)
+    assert r.returncode == 1, r.stderr[-2000:]
+    s = json.load(open(tmp_path / "summary.json"))
+    assert [x.split(":")[0] for x in s["stopped"]] == ["kirsch/mpm 80 mm", "kirsch/mpm 40 mm"]
+    assert [x["method"] for x in s["kirsch"]] == ["mpm", "jcfpm"]          # the 60 mm run and the JCFpm run
+
+
+def test_hybrid_rockfall_small(tmp_path):
+    out = ok(run("hybrid_rockfall.py", "--out", tmp_path, "--spacing", 0.02, "--length", 0.6, "--height", 0.1,
+                 "--end-time", 3e-4, "--vtu-every", 0, "--threads", 1, "--progress", 100))
+    assert "600 MPM particles" in out and (tmp_path / "summary.json").exists()
+
+
+def test_tunnel_variants_small():
+    out = ok(run("tunnel_variants.py", "--case", "intact", "--spacing", 0.0025, "--end-time", 5e-5))
+    res = json.loads(out.split("RESULT ", 1)[1].splitlines()[0])
+    assert res["case"] == "intact" and res["steps"] > 0
+
+
+def test_uniaxial_flaw_3d_small(tmp_path):
+    ok(run("uniaxial_flaw_3d.py", "--out", tmp_path, "--spacing", 0.004, "--slab-cells", 2, "--end-time", 3e-4))
+    assert (tmp_path / "compare.json").exists() and (tmp_path / "3d" / "run.json").exists()
+
+
+def test_penny_prism_3d_small(tmp_path):
+    out = ok(run("penny_prism_3d.py", "--out", tmp_path, "--spacing", 0.004, "--runs", "intact:z", "--end-time", 5e-5))
+    assert "8000 particles" in out and (tmp_path / "summary.json").exists()
+
+
+def test_penny_crack_compare_small(tmp_path):
+    ok(run("penny_crack.py", "--out", tmp_path / "run", "--parts", "damage", "--size", 1.2, "--ramp-time", 0.004,
+           "--end-time", 0.05, "--record-every", 0.005, "--laws", "benz-asphaug", "--progress", 1000))
+    out = ok(run("penny_crack_compare.py", "--out", tmp_path / "cmp", f"a={tmp_path / 'run'}"))
+    assert "| a | 0.02 |" in out and (tmp_path / "cmp.csv").exists() and (tmp_path / "cmp.png").exists()
+
+
+def test_boundaries_study_slip(tmp_path):
+    out = ok(run("boundaries_study.py", "--out", tmp_path, "--parts", "slip"))
+    assert "slip-onesided" in out
+
+
+def test_bench_material_cost_small(tmp_path):
+    out = ok(run("bench_material_cost.py", "--out", tmp_path, "--size", 0.2, "--spacing", 0.02, "--steps", 5, "--repeat", 1))
+    assert "dpgk_full" in out
+
+
+def test_bench_ab_two_builds(tmp_path):
+    """This build against itself, one repeat of the free elastic block."""
+    ok(run("bench_ab.py", "a=py", "b=py", "--out", tmp_path, "--cases", "free_elastic", "--threads", 1, "--repeats", 1))
+    assert (tmp_path / "summary.json").exists() and (tmp_path / "table.md").exists()
+
+
+def test_mpi_scripts_on_one_process(tmp_path):
+    """The MPI scripts run on one process too (mpi_tunnel with the serial core, mpi_checkpoint_big with the
+    MPI build on one rank: save, resume, compare bitwise)."""
+    rb = json.loads(ok(run("mpi_bench.py", "--cells", 10, 10, "--steps", 2, "--warmup", 1)).strip().splitlines()[-1])
+    assert rb["particles_total"] == 400
+    rr = json.loads(ok(run("mpi_rebalance.py", "--spacing", 0.01, "--steps", 10)).strip().splitlines()[-1])
+    assert rr["particles"] > 0
+    ok(run("mpi_tunnel.py", "run", "--out", tmp_path / "t", "--spacing", 0.0025, "--end-time", 5e-5))
+    assert (tmp_path / "t" / "rank0.npz").exists()
+    mpi = {"YADE_MPM_MPI": "1"}
+    for mode in ("save", "resume"):
+        ok(run("mpi_checkpoint_big.py", mode, "--out", tmp_path / "ck", "--cells", 6, 6, 6, "--steps", 2, env=mpi))
+    assert "bitwise resume: True" in ok(run("mpi_checkpoint_big.py", "compare", "--out", tmp_path / "ck"))
