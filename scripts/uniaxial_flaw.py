@@ -117,7 +117,8 @@ def one_run(variant, mu, c_mpa, a):
                  filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
-                 plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"])
+                 plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"],
+                 removed_particles=int(s.removedAccount()["count"]), removed_mass_kg=float(s.removedAccount()["mass"]))   # debris off the grid
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
@@ -219,6 +220,7 @@ def summarize(out):
     with open(os.path.join(out, "peaks.md"), "w") as f:
         f.write(results.peaks_markdown(runs))
     summary = results.summary(runs, t_sig)
+    summary["stopped"] = [f"{os.path.basename(e['dir'])}: {e.get('error')}" for e in runs if e.get("end_reason") == "error"]
     output.write_summary(out, summary)
     print(open(os.path.join(out, "peaks.md")).read())
     return summary
@@ -233,6 +235,10 @@ def main(argv=None):
     summarize(a.out)
     if not a.summary_only:                         # a study's rows (scripts/study_report.py): no wall times
         batch.write_summary(a.out, [dict({k: e[k] for k in results.ROW_KEYS}, end_time_s=a.end_time) for e in entries])
+        stopped = [results.run_name(e["variant"], e["mu_con"], e["c_con_MPa"]) for e in entries if e["end_reason"] == "error"]
+        if stopped:                                # every run ran; the ones the solver stopped are named
+            print(f"stopped by the solver in: {', '.join(stopped)} (outputs written up to the stop)", file=sys.stderr)
+            sys.exit(1)
 
 
 if __name__ == "__main__":

@@ -14,7 +14,7 @@ pytest.importorskip("yade")
 pytest.importorskip("yade_mpm.bodies")   # rigid-body contact (platen, filler)
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KEYS = {"case", "grid_spacing_m", "particles", "steps", "wall_time_s", "particle_steps_per_s", "final_displacement_mm",
-        "axial_stress_MPa_at", "symmetry_damage", "first_damage_location"}
+        "axial_stress_MPa_at", "symmetry_damage", "first_damage_location", "removed"}
 
 
 def run(out, *args):
@@ -35,6 +35,7 @@ def test_outputs_and_resume_equals_one_go(tmp_path):
     assert set(s) == {"cases"} and len(s["cases"]) == 1
     e = s["cases"][0]
     assert set(e) == KEYS and e["case"] == "filled_flaw" and e["grid_spacing_m"] == 0.0025
+    assert e["removed"]["count"] == 0                    # nothing left the grid
     assert e["final_displacement_mm"] == pytest.approx(0.002, rel=0.03)      # 0.1 m/s × 20 µs
     assert [p["displacement_mm"] for p in e["axial_stress_MPa_at"]] == [0.0]
     d = tmp_path / "a" / "filled_flaw"

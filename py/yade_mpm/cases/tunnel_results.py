@@ -57,13 +57,15 @@ def summary_entry(case, solver, state, result, curve_step_mm):
     c = np.array(st["curve"]) if st["curve"] else np.zeros((0, 3))
     sym_key = "08ms" if "08ms" in snap else (sorted(snap)[-1] if snap else None)
     fc = st["first_crack"]
+    acc = solver.removedAccount()
     return {"case": case, "grid_spacing_m": solver.spacing, "particles": int(solver.numParticles), "steps": int(st.get("steps", solver.steps)),
             "wall_time_s": round(st["wall"], 2),
             "particle_steps_per_s": float(solver.numParticles * st["steps_run"] / st["wall"]) if st["wall"] > 0 else None,
             "final_displacement_mm": st.get("final_displacement", c[-1, 1] if len(c) else 0.0) * 1e3,
             "axial_stress_MPa_at": sample_curve(st["curve"], curve_step_mm),
             "symmetry_damage": snap[sym_key]["symmetry_damage"] if sym_key else None,
-            "first_damage_location": fc["location"] if fc else None}
+            "first_damage_location": fc["location"] if fc else None,
+            "removed": {k: acc[k] for k in ("count", "mass", "kinetic_energy", "last_time", "faces")}}   # debris off the grid
 
 
 def ordering(entries):
