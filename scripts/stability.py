@@ -19,14 +19,17 @@ from yade_mpm.validation.stability import CASES, ENERGY_FLOOR, ENERGY_TOL, run_c
 
 def print_table(rows, stream=sys.stdout):
     head = (f"{'case':22s} {'steps':>7s} {'max E ratio':>11s} {'dt/lim':>7s} {'dt/lim1':>7s} {'outcome':20s} {'NaN':>4s} "
-            f"{'wall [s]':>8s}  pass")
+            f"{'wall [s]':>8s} {'removed (expected)':>22s}  pass")
     print(head, file=stream)
     print("-" * len(head), file=stream)
     for r in rows:
         print(f"{r['case']:22s} {r['steps']:7d} {r['max_energy_ratio']:11.4f} {r['max_dt_over_stable']:7.4f} "
               f"{r['max_dt_over_paper_limit_after_step']:7.4f} "
-              f"{r['outcome']:20s} {'yes' if r['nan_seen'] else 'no':>4s} {r['wall_time_s']:8.2f}  "
+              f"{r['outcome']:20s} {'yes' if r['nan_seen'] else 'no':>4s} {r['wall_time_s']:8.2f} "
+              f"{str(r.get('removed_particles', 0)) + ' (' + r.get('removed_expected', 'none') + ')':>22s}  "
               f"{'ok' if r['passed'] else 'FAIL'}", file=stream)
+    print("removed: particles removed after leaving the grid (Solver.outside = 'remove-debris'), against the case's expectation",
+          file=stream)
     print("dt/lim: max Δt / stableDt() before the step (C = s.courant); dt/lim1: max Δt / (l/(v_c + max‖v‖)) after "
           "the step (paper's limit, C = 1)", file=stream)
     for r in rows:
@@ -102,9 +105,10 @@ def main(argv=None):
     print()
     print_table(rows)
     out.write_csv(os.path.join(args.out, "stability_table.csv"),
-                  ["case", "steps", "max_energy_ratio", "max_dt_over_stable", "outcome", "nan_seen", "wall_time_s", "passed"],
+                  ["case", "steps", "max_energy_ratio", "max_dt_over_stable", "outcome", "nan_seen", "wall_time_s", "removed_particles",
+                   "removed_mass_kg", "momentum_error_rel", "passed"],
                   [[r["case"], r["steps"], r["max_energy_ratio"], r["max_dt_over_stable"], r["outcome"], r["nan_seen"],
-                    r["wall_time_s"], r["passed"]] for r in rows])
+                    r["wall_time_s"], r["removed_particles"], r["removed_mass_kg"], r.get("momentum_error_rel", ""), r["passed"]] for r in rows])
     plot_ratios(os.path.join(args.out, "energy_ratio.png"), hists)
     plot_final_states(os.path.join(args.out, "final_states.png"), hists)
     out.write_summary(args.out, {
