@@ -5,6 +5,16 @@
 #pragma once
 #include "ParamTable.hpp"
 
+namespace mpm {
+// How the contact keeps particles out of a rigid body (doc/contact.md, "Contact laws").
+enum class ContactLaw : int {
+	Kinematic = 0, // impulses at the contacting particles: no approach, residual overlap closed in one step, Coulomb +
+	               // cohesion as an impulse limit; the Δt → 0 limit of Eq. 23 reached at any Δt (KinematicContact.hpp)
+	Penalty   = 1  // Eq. 23 exactly as printed: f = (1 − χ) κ_p (d0 − d_p) n_p, κ_p = 2 m_p/Δt² (the paper's; default)
+};
+MPM_CHOICES(ContactLaw, "kinematic|penalty")
+} // namespace mpm
+
 // X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
 // chi default ½: positions advance with the updated velocity (x += Δt v^{n+1}), so (1 − χ) κ = m/Δt² takes a
 // penetrating particle back to d0 in exactly one step; χ = 0 pushes it out by twice its penetration (the
@@ -15,12 +25,16 @@
 // domain, e.g. a flaw filler, touches the material around it at zero force from t = 0), every other particle
 // keeps the autoD0/d0 value. First layer: d_p(0) < e_p max_i |n_i| (ContactGroups::captureInitialD0).
 #define MPM_CONTACT_PARAMS(X)                                                                                                     \
+	X(ContactLaw, law, ContactLaw::Penalty, "-", 0, 1, CC, "",                                                                 \
+	  "'penalty' (default): Eq. 23 as printed, κ_p = 2 m_p/Δt² (a contact compliance that grows with Δt²); "              \
+	  "'kinematic': no-penetration impulses at the contacting particles (projected Gauss–Seidel), independent of Δt", "Eqs. 23–26", "")         \
 	X(Real, mu, 0, "-", 0, INFINITY, CO, "μ_con",                                                                                \
 	  "Coulomb friction coefficient of the contact (ym.RigidBodies/DemSpheres.add without mu: tan(frictionAngle) of the "     \
 	  "body's YADE FrictMat)", "Eq. 24", "")                                                                                     \
 	X(Real, cohesion, 0, "Pa", 0, INFINITY, CO, "c_con", "contact cohesion (tangential capacity per contact area)", "Eq. 24", "") \
 	X(Real, chi, 0.5, "-", 0, 1, CO, "χ",                                                                                        \
-	  "residual penetration factor: the normal penalty is (1 − χ) κ_p (d0 − d_p), κ_p = 2 m_p/Δt²", "Eq. 23", "")               \
+	  "residual penetration factor of the penalty law: the normal force is (1 − χ) κ_p (d0 − d_p), κ_p = 2 m_p/Δt² "             \
+	  "(unused by the kinematic law)", "Eq. 23", "")               \
 	X(Real, d0, 0, "m", 0, INFINITY, CO, "d0",                                                                                   \
 	  "detection distance when autoD0 is off; at most one grid spacing (checked when the group is added)", "Eq. 23", "")       \
 	X(bool, autoD0, true, "-", 0, 1, CC, "", "d0 = ½ V_p^{1/D}, half the particle's own edge (registration keyword d0=None)",  \
@@ -32,7 +46,7 @@
 namespace mpm {
 
 struct ContactParams {
-	MPM_PARAMS(ContactParams, NoParams, MPM_CONTACT_PARAMS) // μ, c, χ, d0, autoD0, initialD0
+	MPM_PARAMS(ContactParams, NoParams, MPM_CONTACT_PARAMS) // law, μ, c, χ, d0, autoD0, initialD0
 
 	// The table's ranges. d0 beyond one cell is refused where the grid is known (validateFor).
 	void validate() const { validateParams(); }

@@ -63,6 +63,7 @@
 #include "ContactGroups.hpp"
 #include "ContactMpi.hpp"
 #include "GridBoxes.hpp"
+#include "KinematicContact.hpp"
 #include "WlsShape.hpp"
 
 namespace mpm {
@@ -165,6 +166,12 @@ public:
 			const auto& g  = groups[gi];
 			const auto& wk = work[gi];
 			if (wk.skip) continue;
+			if (g.params.law == ContactLaw::Kinematic) { // KinematicContact.hpp
+				MPM_ONE_THREAD
+				applyKinematic(grid, P, sched, offs, g, wk, dt, massFloor, err);
+				MPM_ONE_THREAD_END
+				continue;
+			}
 			const size_t nn = boxCount(wk.nlo, wk.nhi);
 #pragma omp for schedule(static)
 			for (size_t j = 0; j < nn; ++j) {
@@ -400,6 +407,126 @@ private:
 			}
 		}
 	}
+	// ---------------------------------------------------------------- kinematic law (KinematicContact.hpp), one thread
+	std::vector<KinematicContactRec<D>> kc; // the contacts of the group being processed (capacity kept between steps)
+	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
+	Vec bodyCompliance(const RigidPart<D>& q, const Vec& r, const Vec& e) const
+	{
+		if (!q.movable()) return Vec::Zero();
+		return e / q.mass + crossSpin<D>(SpinOf<D>(q.inverseInertia() * momentOf<D>(r, e)), r);
+	}
+	void applyKinematic(Grid<D>& grid, const Particles<D>& P, const BlockSchedule<D>& sched, const StencilOffsets<D>& offs, const RigidGroup<D>& g,
+	                    const Work& wk, Real dt, Real massFloor, ErrorRecord& err)
+	{
+		MPM_IF_MPI(if (dd && dd->distributed()) { err.record(0, "is in a scene with a kinematic contact group, which MPI does not run yet (use law='penalty')"); return; })
+		kc.clear();
+		const Real*  d0i  = g.d0Initial.empty() ? nullptr : g.d0Initial.data();
+		const size_t nd0i = g.d0Initial.size();
+		// 1. the contacting particles of the blocks near the body, in block order
+		IVec b;
+		for (int a = 0; a < D; ++a) b[a] = wk.blo[a];
+		while (true) {
+			size_t bl = 0, s = 1;
+			for (int a = 0; a < D; ++a) bl += size_t(b[a]) * s, s *= sched.nBlocks[a];
+			for (uint32_t p = sched.start[bl]; p < sched.start[bl + 1]; ++p) {
+				Vec x;
+				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+				const Real e  = edgeOf(P.vol[p]);
+				Real       d0 = g.params.autoD0 ? 0.5 * e : g.params.d0;
+				if (d0i) {
+					const size_t id = size_t(P.id[p]);
+					if (id < nd0i && d0i[id] == d0i[id]) d0 = d0i[id];
+				}
+				if (d0 > wk.reach) continue;
+				const auto h = g.query(x);
+				if (!(h.d - d0 < kinematicTouch * e)) continue;
+				Stencil<D> st;
+				if (!computeStencil(grid, offs, x.data(), st)) {
+					err.record(p, "is in contact with a rigid body but has too few active grid nodes for the WLS fit (penetrated the body?)");
+					continue;
+				}
+				KinematicContactRec<D> c;
+				c.nn = 0, c.kinvGrid = 0;
+				for (int n = 0; n < N; ++n) {
+					const size_t i = st.base + offs.off[n];
+					if (st.psi[n] == 0 || !(grid.nodes[i].m > massFloor)) continue;
+					c.node[c.nn] = i, c.psi[c.nn] = st.psi[n], c.psiOverM[c.nn] = st.psi[n] / grid.nodes[i].m;
+					c.kinvGrid += st.psi[n] * c.psiOverM[c.nn], ++c.nn;
+				}
+				if (c.nn == 0) continue;
+				c.part = g.parts.size() == 1 ? g.parts[0] : h.part;
+				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
+				c.g    = (d0 - h.d) / dt;
+				c.cap0 = g.params.cohesion * (P.vol[p] / e) * dt;
+				c.lam.setZero(), c.p = p;
+				kc.push_back(c);
+			}
+			int a = 0;
+			for (; a < D; ++a) {
+				if (b[a] < wk.bhi[a]) { ++b[a]; break; }
+				b[a] = wk.blo[a];
+			}
+			if (a == D) break;
+		}
+		// 2. projected Gauss–Seidel on the impulses (free parts' velocity changes in dq)
+		for (int p : g.parts) dq[p] = Motion {};
+		const Real mu = g.params.mu;
+		Real       scale = 0;
+		for (int sweep = 0; sweep < kinematicSweeps; ++sweep) {
+			Real worst = 0;
+			for (auto& c : kc) {
+				const auto& q = parts[c.part];
+				Vec         vp = Vec::Zero();
+				for (int k = 0; k < c.nn; ++k)
+					for (int a = 0; a < D; ++a) vp[a] += c.psi[k] * grid.vel[c.node[k]].c[a];
+				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r);
+				if (sweep == 0) scale = std::max(scale, u.norm());
+				// normal
+				const Real kn   = 1 / (c.kinvGrid + c.n.dot(bodyCompliance(q, c.r, c.n)));
+				const Real ln0  = c.lam.dot(c.n);
+				const Real ln   = std::max(Real(0), ln0 + kn * (c.g - u.dot(c.n)));
+				// tangential: stop the slip with the grid's effective mass (the body's adds at most a few % near a light body)
+				const Vec  lt0  = c.lam - ln0 * c.n;
+				const Vec  ut   = u - u.dot(c.n) * c.n;
+				Vec        lt   = lt0 - ut / (c.kinvGrid + (ut.norm() > 0 ? ut.normalized().dot(bodyCompliance(q, c.r, ut.normalized())) : 0));
+				const Real cap  = mu * ln + c.cap0;
+				const Real ltn  = lt.norm();
+				if (ltn > cap) lt *= cap / ltn; // slip at the limit (Eq. 24)
+				const Vec lam = ln * c.n + lt;
+				const Vec dl  = lam - c.lam;
+				if (dl.isZero(0)) continue;
+				c.lam = lam;
+				for (int k = 0; k < c.nn; ++k) {
+					const size_t  i   = c.node[k];
+					const uint8_t fix = grid.fixMask[i];
+					for (int a = 0; a < D; ++a)
+						if (!((fix >> a) & 1)) grid.vel[i].c[a] += c.psiOverM[k] * dl[a];
+				}
+				if (q.movable()) { // the free body takes −Δλ at x_p
+					dq[c.part].v -= dl / q.mass;
+					dq[c.part].w -= SpinOf<D>(q.inverseInertia() * momentOf<D>(c.r, dl));
+				}
+				worst = std::max(worst, dl.norm() * c.kinvGrid);
+			}
+			if (worst <= kinematicTol * (scale + 1e-12)) break;
+		}
+		// 3. reactions (−λ/Δt at x_p) and the nodal contact forces Σ_p ψ_i λ_p/Δt, in contact order
+		auto&        A  = nodeArr;
+		const size_t nb = boxCount(wk.nlo, wk.nhi);
+		for (size_t j = 0; j < nb; ++j) {
+			const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+			for (int a = 0; a < D; ++a) A.force[a][i] = 0;
+		}
+		for (const auto& c : kc) {
+			const Vec f = c.lam / dt;
+			auto&     q = parts[c.part];
+			q.force -= f;
+			q.torque -= momentOf<D>(c.r, f);
+			for (int k = 0; k < c.nn; ++k)
+				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.psi[k] * f[a];
+		}
+	}
+
 	std::vector<QMat> Aq; // per part: A of bodyResponse
 	std::vector<QVec> bq; // per part: b (+ c) of bodyResponse
 	MPM_IF_MPI(std::vector<double> flags;) // MPI scratch of reduceParts

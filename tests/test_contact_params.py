@@ -15,7 +15,7 @@ import yade_mpm as ym
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 UNIT = re.compile(r"\[[^\]]+\]")
-RANGE = re.compile(r"range [\[(][^,]+, [^\])]+[\])]|True or False")
+RANGE = re.compile(r"range [\[(][^,]+, [^\])]+[\])]|True or False|one of '")
 G = 9.81
 ELASTIC = dict(young=2e7, poisson=0.25, density=1000.0)
 
@@ -24,11 +24,11 @@ def test_every_contact_attribute_has_unit_range_and_doc():
     cls = ym.ContactParams
     attrs = sorted(n for n in dir(cls) if not n.startswith("_") and isinstance(getattr(cls, n), property))
     table = {p["name"]: p for p in cls.paramTable()}
-    assert set(attrs) == set(table) == {"mu", "cohesion", "chi", "d0", "autoD0", "initialD0"}
+    assert set(attrs) == set(table) == {"law", "mu", "cohesion", "chi", "d0", "autoD0", "initialD0"}
     for n in attrs:
         doc = getattr(cls, n).__doc__ or ""
         assert UNIT.search(doc) and RANGE.search(doc), f"ContactParams.{n}: {doc!r}"
-        assert table[n]["doc"] and table[n]["doc"] in doc and table[n]["eq"].startswith("Eq."), n
+        assert table[n]["doc"] and table[n]["doc"] in doc and table[n]["eq"].startswith("Eq"), n
         assert n in cls.__doc__
     # units and ranges as the paper states them (Sec. 2.3: 0 ≤ χ < 1)
     assert (table["chi"]["lo"], table["chi"]["hi"], table["chi"]["loOpen"], table["chi"]["hiOpen"]) == (0, 1, False, True)
@@ -50,7 +50,7 @@ def test_contact_ranges_are_enforced_at_the_ends_and_round_trip():
                 setattr(c, p["name"], end)
     c = ym.contact_params(mu=0.35, cohesion=2e5, chi=0.25, d0=0.004)
     d = c.toDict()
-    assert d == dict(mu=0.35, cohesion=2e5, chi=0.25, d0=0.004, autoD0=False, initialD0=False)
+    assert d == dict(law="penalty", mu=0.35, cohesion=2e5, chi=0.25, d0=0.004, autoD0=False, initialD0=False)
     assert ym.ContactParams.fromDict(json.loads(json.dumps(d))).toDict() == d
     assert ym.contact_params(d0="initial").toDict()["initialD0"] is True
 
@@ -61,7 +61,7 @@ def test_doc_contact_md_holds_the_generated_table():
 
 
 def test_one_registration_shape_for_rigid_bodies_and_spheres():
-    keywords = ["ids", "mu", "cohesion", "chi", "d0", "thickness"]
+    keywords = ["ids", "mu", "cohesion", "chi", "d0", "thickness", "law"]
     for cls in (ym.RigidBodies, ym.DemSpheres):
         sig = inspect.signature(cls.add)
         assert list(sig.parameters)[1:] == keywords, cls

@@ -27,7 +27,7 @@ their vertices; a wall: 1 m), or the ``thickness`` given to ``add``. The force a
 per metre of the plane-strain slice: its dynamics match the MPM side for any t. ``force(id)`` and
 ``torque(id)`` return the per-metre values. A 2D body must stay in the plane (rotation about z only).
 
-Contact parameters: the keywords ``mu``, ``cohesion``, ``chi``, ``d0`` of ``add`` (the same for
+Contact parameters: the keywords ``law``, ``mu``, ``cohesion``, ``chi``, ``d0`` of ``add`` (the same for
 ``DemSpheres.add``) make one ``ym.ContactParams``, whose parameters are declared once, with unit, range,
 default and equation, in pkg-mpm/ContactParams.hpp (``print(ym.materials.describe(ym.ContactParams))``;
 table in doc/contact.md). Every keyword is checked before any work; NumPy scalars are numbers.
@@ -40,6 +40,9 @@ table in doc/contact.md). Every keyword is checked before any work; NumPy scalar
             first lattice layer next to the body when ``add`` registers it get d0 = their initial distance to
             its surface (a body filling a domain, e.g. a flaw filler); the body must not overlap any particle
             centre (ValueError).
+  law       "penalty" (default): the paper's Eq. 23 as printed (κ = 2m/Δt²; chi applies to it only);
+            "kinematic": no-penetration impulses at the contacting particles, results independent of Δt
+            (doc/contact.md, "Contact laws").
   cohesion, chi: given or the declared defaults.
 """
 import math
@@ -53,10 +56,10 @@ from .scene import dim_of
 D0_CHOICES = "None (half the particle edge) or 'initial' (the first layer's initial distance)"
 
 
-def contact_params(mu=None, cohesion=None, chi=None, d0=None):
+def contact_params(mu=None, cohesion=None, chi=None, d0=None, law=None):
     """``ContactParams`` from the registration keywords (None: the declared default; d0: None, "initial" or a
     number [m], see the module docstring). Ranges come from the declaration (ValueError naming the keyword)."""
-    kw = {k: v for k, v in (("mu", mu), ("cohesion", cohesion), ("chi", chi)) if v is not None}
+    kw = {k: v for k, v in (("mu", mu), ("cohesion", cohesion), ("chi", chi), ("law", law)) if v is not None}
     if isinstance(d0, str):
         if d0 != "initial":
             raise ValueError(f"d0 = {d0!r} is not a choice: a number [m] in [0, grid spacing], {D0_CHOICES}")
@@ -182,12 +185,13 @@ class RigidBodies:
         self.groups = []      # core group indices, one per add()
 
     # ------------------------------------------------------------------ set-up
-    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None):
+    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None, law=None):
         """Register YADE bodies (an id or a list) as one contact group with friction coefficient mu [-]
         (not given: tan(frictionAngle) of the bodies' YADE FrictMat; explicit values win), cohesion [Pa],
         residual penetration factor chi [-] and detection distance d0 (None: half the particle edge; a number
         [m] up to one grid spacing; "initial": the first particle layer's distance to the body now); ranges
-        and defaults: ``ym.ContactParams`` (module docstring). thickness [m] overrides the 2D z-extent.
+        and defaults: ``ym.ContactParams`` (module docstring). thickness [m] overrides the 2D z-extent. law:
+        "penalty" (default, Eq. 23 as printed) or "kinematic" (independent of Δt).
         Everything is checked before the solver changes. Returns the group index."""
         ids = body_ids(ids)
         check_thickness(thickness)
@@ -198,7 +202,7 @@ class RigidBodies:
                 raise ValueError(f"body id {i} is already registered for contact")
             check_state(b)
             bodies.append(b)
-        prm = contact_params(friction_of(bodies) if mu is None else mu, cohesion, chi, d0)
+        prm = contact_params(friction_of(bodies) if mu is None else mu, cohesion, chi, d0, law)
         prm.validateFor(self.solver.spacing)
         prims = [self._primitives(b) for b in bodies]   # validates shapes before touching the solver
         s = self.solver

@@ -93,7 +93,7 @@ class DemSpheres:
         self.wall = 0.0                 # wall seconds spent in read() and write() (Python side of the coupling)
         self._newton = None
 
-    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None):
+    def add(self, ids, mu=None, cohesion=None, chi=None, d0=None, thickness=None, law=None):
         """Register YADE spheres and clumps of spheres (an id, a list, or "all": every sphere that is not a
         clump member and every clump of spheres in O.bodies not registered yet), each its own contact group,
         with the keywords of ``RigidBodies.add`` (mu not given: tan(frictionAngle) of each body's FrictMat;
@@ -121,7 +121,7 @@ class DemSpheres:
             if kind is None:
                 raise ValueError(f"body id {i} has shape {type(b.shape).__name__}; DemSpheres takes spheres and clumps of "
                                  "spheres (use yade_mpm.RigidBodies for boxes, walls, facets)")
-            prm = contact_params(friction_of([b]) if mu is None else mu, cohesion, chi, d0)
+            prm = contact_params(friction_of([b]) if mu is None else mu, cohesion, chi, d0, law)
             prm.validateFor(s.spacing)
             rows.append((b, self._members(b, kind), prm))
         n0, n = len(self.ids), len(rows)

@@ -8,18 +8,18 @@ FILLER_CHI = 0.5                   # filler–rock residual penetration factor �
 BODY_HALF_THICKNESS = 0.5          # YADE box half-extent along z [m]: thickness 1 m
 
 
-def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0, d0=None):
+def yade_platen(rb, x_center, top, width, spacing, speed, friction, cohesion=0.0, d0=None, law=None):
     """A rigid YADE Box platen resting on the specimen top y = `top` [m] (its lower face there: the top
     particle row is then at the default detection distance, half a particle edge), 1.2 × `width` wide
     and 10 cells high, blockedDOFs 'xyzXYZ', moving down at `speed` [m/s]; registered in the
     RigidBodies `rb` with μ = friction [-], c = cohesion [Pa], detection distance d0 (None: half the
-    particle edge, ``RigidBodies.add``). Returns its YADE id."""
+    particle edge, ``RigidBodies.add``) and contact law `law` (None: the declared default). Returns its YADE id."""
     from yade import O, utils
     hp = 5 * spacing                               # platen half-height
     pid = O.bodies.append(utils.box((x_center, top + hp, 0), (0.6 * width, hp, BODY_HALF_THICKNESS), fixed=False))
     O.bodies[pid].state.blockedDOFs = "xyzXYZ"
     O.bodies[pid].state.vel = (0, -speed, 0)
-    rb.add(pid, mu=friction, cohesion=cohesion, d0=d0)
+    rb.add(pid, mu=friction, cohesion=cohesion, d0=d0, law=law)
     return pid
 
 
@@ -32,7 +32,7 @@ def blocked_dofs(value, name="blockedDOFs"):
     return value
 
 
-def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None):
+def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None, law=None):
     """A free rigid YADE Box that is the flaw (dict of ``tunnel_flaw``): the domain of the filling, its
     length × width, registered in `rb` with d0 = "initial" (doc/contact.md) so the particles next to it —
     the flaw is cut from the particle lattice, its faces are jagged — touch it at zero force from t = 0;
@@ -40,7 +40,7 @@ def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", c
     [-], c = cohesion [Pa], χ = chi [-] (None: FILLER_CHI); density [kg/m³] (None: YADE's default 1000):
     its true mass, lighter than the grid nodes along its faces — the stick step moves it with its contact
     nodes (doc/contact.md). The grid nodes it covers get the contact exclusion bit, as an open flaw's nodes
-    get the user bit. Returns its YADE id."""
+    get the user bit. law: contact law (None: the declared default). Returns its YADE id."""
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3
     from yade.wrapper import FrictMat
@@ -51,7 +51,7 @@ def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", c
                                     orientation=Quaternion(Vector3(0, 0, 1), ang), fixed=False, **kw))
     st = O.bodies[fid].state
     st.blockedDOFs = blocked                       # default in the plane: x, y, rotation about z
-    rb.add(fid, mu=friction, cohesion=cohesion, chi=FILLER_CHI if chi is None else chi, d0="initial")
+    rb.add(fid, mu=friction, cohesion=cohesion, chi=FILLER_CHI if chi is None else chi, d0="initial", law=law)
     return fid
 
 

@@ -108,7 +108,7 @@ def tunnel_flaw_at(floor=TUNNEL_FLOOR, angle=FLAW_ANGLE, toe_gap=FLAW_TOE_GAP, t
 
 def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
                 platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm",
-                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP, flaw_toe_height=FLAW_TOE_HEIGHT):
+                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP, flaw_toe_height=FLAW_TOE_HEIGHT, contact_law=None):
     """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
     arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
     DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
@@ -122,6 +122,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     floor [m]: height of the opening's floor (default TUNNEL_FLOOR = 55 mm; the paper gives none, a centred
     opening has 52.5 mm); flaw_toe_gap, flaw_toe_height [m]: the toe's distance from the left wall and height above
     the floor (``tunnel_flaw_at``; neither is given in the paper).
+    contact_law: the platen and filler contact law, "kinematic" or "penalty" (None: the declared default).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
@@ -152,8 +153,9 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
         add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
     O.reset()
     rb = RigidBodies(s)
-    platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction)
-    filler = yade_filler(rb, flaw, filler_friction, density=rock.density) if case == "filled_flaw" else None  # weighs as the rock
+    platen = yade_platen(rb, W / 2, W, W, spacing, platen_speed, platen_friction, law=contact_law)
+    filler = (yade_filler(rb, flaw, filler_friction, density=rock.density, law=contact_law)  # weighs as the rock
+              if case == "filled_flaw" else None)
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
 

@@ -49,7 +49,7 @@ def exclude_nodes_inside(solver, polygon):
 def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
                   platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY",
                   ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM, slab_cells=0,
-                  platen_d0=None):
+                  platen_d0=None, contact_law=None):
     """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
     ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
@@ -76,6 +76,8 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     platen_d0: the platen's contact detection distance [m] (None, default: half the particle edge ½V^(1/D) of
     the current volume, which differs between 2D and 3D once the volume changes; a number makes a slab
     and the 2D run identical to roundoff, doc/three_d.md).
+    contact_law: the law of the platen and filler contacts, "kinematic" or "penalty" (None: the declared default;
+    doc/contact.md).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
@@ -125,8 +127,9 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     if not with_bodies:
         return s, dict(engine=yade_engines(s, None, label), flaw=flaw, width=W, height=H, thickness=T)
     rb = RigidBodies(s)
-    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction, d0=platen_d0)
-    filler = yade_filler(rb, flaw, mu_con, c_con, density=rock.density, blocked=filler_blocked) if variant == "filled" else None
+    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, platen_friction, d0=platen_d0, law=contact_law)
+    filler = (yade_filler(rb, flaw, mu_con, c_con, density=rock.density, blocked=filler_blocked, law=contact_law)
+              if variant == "filled" else None)
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
 

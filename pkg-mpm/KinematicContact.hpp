@@ -1,0 +1,48 @@
+// The kinematic contact law (ContactLaw::Kinematic, the default; doc/contact.md "Contact laws"): the Δt → 0
+// limit of Eq. 23 — a non-penetrating frictional contact at the particles' faces — reached at any Δt by
+// constraining velocities instead of pushing with a penalty spring whose compliance grows with Δt².
+//
+// Detection is the PTS test of Eq. 23 at each particle: d_p − d0 < ε_p (ε_p = 1e-3 of the particle's edge keeps a
+// particle resting at d0 in contact, so its cohesion does not flicker), n_p the body's outward normal at the
+// closest surface point. The constraint acts on what the particle moves with, its material-point velocity
+// v_p = Σ_i ψ_i v_i (the WLS fit, Eq. 6; positions advance with it), relative to the body at x_p,
+// u_p = v_p − (v + ω × r_p) (Eq. 26), after the grid update:
+//   normal      u_p·n_p ≥ g_p,  g_p = (d0 − d_p)/Δt       (no approach; an overlap is closed in one step)
+//   tangential  u_p,tan = 0 while ‖λ_t‖ ≤ μ λ_n + c a_p Δt  (Eq. 24 as an impulse limit, a_p the particle's face)
+// with impulses λ_p applied to the nodes as Δv_i = ψ_i λ_p/m_i (Σ_i ψ_i = 1: the grid gains exactly Σ λ_p, the
+// body receives −λ_p/Δt at x_p: momentum conserved to round-off; Σ_i ψ_i x_i = x_p: the moment acts at x_p).
+// The particles share nodes, so the impulses are found together by projected Gauss–Seidel over the contacts in
+// a fixed order (deterministic, serial), each update with the effective mass of its direction,
+//   1/k = Σ_i ψ_i²/m_i + e·(W_B e)  (W_B: the free body's inverse mass and inertia at r_p; 0 if prescribed),
+// λ_n clamped ≥ 0 and λ_t to the Coulomb + cohesion disc; a free body's velocity is updated with each impulse
+// (−W_B J_pᵀ Δλ), so it takes its share of every exchange.
+#pragma once
+#include "MpmTypes.hpp"
+
+namespace mpm {
+
+// Detection tolerance of the kinematic law, as a fraction of the particle's edge (ε_p above).
+constexpr Real kinematicTouch = 1e-3;
+// Projected Gauss–Seidel: at most this many sweeps over the contacts, fewer when the largest velocity
+// correction of a sweep falls below kinematicTol × (the largest relative speed of the first sweep + 1e-12 m/s).
+constexpr int  kinematicSweeps = 60;
+constexpr Real kinematicTol    = 1e-6;
+
+// One contacting particle of a kinematic group.
+template <int D>
+struct KinematicContactRec {
+	using Vec = typename Dim<D>::Vec;
+	static constexpr int N = Dim<D>::nStencil;
+	size_t   node[N]; // stencil nodes (those with ψ_i ≠ 0 and a mass above the floor first, count nn)
+	Real     psiOverM[N], psi[N];
+	int      nn;
+	int      part;
+	Vec      x, n, r;  // particle position, contact normal, lever arm x_p − c
+	Real     g;        // target normal rate (d0 − d_p)/Δt [m/s]
+	Real     cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
+	Real     kinvGrid; // Σ ψ_i²/m_i [1/kg]
+	Vec      lam;      // impulse on the particle [N s]
+	uint32_t p;        // storage index (diagnostics)
+};
+
+} // namespace mpm
