@@ -1,4 +1,4 @@
-// The kinematic contact law (ContactLaw::Kinematic, the default; doc/contact.md "Contact laws"): the Δt → 0
+// The kinematic contact law (ContactLaw::Kinematic, a named option beside Eq. 23's penalty; doc/contact.md "Contact laws"): the Δt → 0
 // limit of Eq. 23 — a non-penetrating frictional contact at the particles' faces — reached at any Δt by
 // constraining velocities instead of pushing with a penalty spring whose compliance grows with Δt².
 //
@@ -42,7 +42,6 @@ struct KinematicContactRec {
 	Real     cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
 	Real     kinvGrid; // Σ ψ_i²/m_i [1/kg]
 	Vec      lam;      // impulse on the particle [N s]
-	uint32_t p;        // storage index (diagnostics)
 };
 
 } // namespace mpm

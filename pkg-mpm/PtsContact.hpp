@@ -181,8 +181,6 @@ public:
 			}
 			// 1. normal penalty force of the contacted particles, Eq. 23
 			const Real chi = g.params.chi, twoOverDt2 = 2.0 / (dt * dt);
-			const Real*  d0i = g.d0Initial.empty() ? nullptr : g.d0Initial.data(); // d0 = "initial": per particle id
-			const size_t nd0i = g.d0Initial.size();
 			for (int c = 0; c < Dim<D>::nColours; ++c) {
 				IVec first, cnt;
 				size_t nb = 1;
@@ -203,11 +201,7 @@ public:
 					for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) {
 						Vec x;
 						for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
-						Real d0 = g.params.autoD0 ? 0.5 * edgeOf(P.vol[p]) : g.params.d0;
-						if (d0i) {
-							const size_t id = size_t(P.id[p]);
-							if (id < nd0i && d0i[id] == d0i[id]) d0 = d0i[id]; // first layer at registration: d0_p = d_p(0)
-						}
+						const Real d0 = detectionDistance(g, P, p, edgeOf(P.vol[p]));
 						if (d0 > wk.reach) continue; // beyond the detection margin (documented limit)
 						const auto h = g.query(x);
 						if (!(h.d - d0 < 0)) continue;
@@ -407,6 +401,13 @@ private:
 			}
 		}
 	}
+	// d0 of particle p (edge e_p): ½ e_p (autoD0) or the fixed d0, or for d0 = "initial" the first layer's d_p(0).
+	static Real detectionDistance(const RigidGroup<D>& g, const Particles<D>& P, uint32_t p, Real e)
+	{
+		const size_t id = size_t(P.id[p]);
+		if (id < g.d0Initial.size() && g.d0Initial[id] == g.d0Initial[id]) return g.d0Initial[id]; // d0_p = d_p(0)
+		return g.params.autoD0 ? 0.5 * e : g.params.d0;
+	}
 	// ---------------------------------------------------------------- kinematic law (KinematicContact.hpp), one thread
 	std::vector<KinematicContactRec<D>> kc; // the contacts of the group being processed (capacity kept between steps)
 	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
@@ -420,8 +421,6 @@ private:
 	{
 		MPM_IF_MPI(if (dd && dd->distributed()) { err.record(0, "is in a scene with a kinematic contact group, which MPI does not run yet (use law='penalty')"); return; })
 		kc.clear();
-		const Real*  d0i  = g.d0Initial.empty() ? nullptr : g.d0Initial.data();
-		const size_t nd0i = g.d0Initial.size();
 		// 1. the contacting particles of the blocks near the body, in block order
 		IVec b;
 		for (int a = 0; a < D; ++a) b[a] = wk.blo[a];
@@ -432,11 +431,7 @@ private:
 				Vec x;
 				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
 				const Real e  = edgeOf(P.vol[p]);
-				Real       d0 = g.params.autoD0 ? 0.5 * e : g.params.d0;
-				if (d0i) {
-					const size_t id = size_t(P.id[p]);
-					if (id < nd0i && d0i[id] == d0i[id]) d0 = d0i[id];
-				}
+				const Real d0 = detectionDistance(g, P, p, e);
 				if (d0 > wk.reach) continue;
 				const auto h = g.query(x);
 				if (!(h.d - d0 < kinematicTouch * e)) continue;
@@ -458,7 +453,7 @@ private:
 				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
 				c.g    = (d0 - h.d) / dt;
 				c.cap0 = g.params.cohesion * (P.vol[p] / e) * dt;
-				c.lam.setZero(), c.p = p;
+				c.lam.setZero();
 				kc.push_back(c);
 			}
 			int a = 0;
