@@ -46,6 +46,14 @@ public:
 	void beforeTransfer(ContactStep<D>& s) { PtsContact<D>::beforeTransfer(s.tr.grid, s.tr.sched); }
 	// Between gridUpdate and g2p, inside the parallel region: Eqs. 23–26 and the body reactions.
 	void apply(ContactStep<D>& s) { PtsContact<D>::apply(s.tr.grid, s.tr.P, s.tr.sched, s.tr.offs, s.dt, s.massFloor, s.err); }
+	// After the late damping (dampAfterContact), inside the region: kinematic groups restore their constraints.
+	void reproject(ContactStep<D>& s)
+	{
+		if (!PtsContact<D>::hasKinematic()) return;
+		MPM_ONE_THREAD
+		PtsContact<D>::reprojectKinematic(s.tr.grid, s.dt);
+		MPM_ONE_THREAD_END
+	}
 };
 
 } // namespace mpm

@@ -40,7 +40,7 @@ struct KinematicContactRec {
 	Vec      x, n, r;  // particle position, contact normal, lever arm x_p − c
 	Real     g;        // target normal rate (d0 − d_p)/Δt [m/s]
 	Real     cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
-	Real     kinvGrid; // Σ ψ_i²/m_i [1/kg]
+	Vec      kinvAxis; // Σ ψ_i²/m_i over the nodes whose component a is free [1/kg]
 	Vec      lam;      // impulse on the particle [N s]
 };
 

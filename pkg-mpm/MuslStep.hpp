@@ -88,7 +88,10 @@ inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<
 			if (in.withContact) {
 				contact.apply(cs); // 3: Eqs. 23–26
 #pragma omp barrier
-				if (dampLate) dampAfterContact(grid, in.dt, in.damping, in.massFloor);
+				if (dampLate) {
+					dampAfterContact(grid, in.dt, in.damping, in.massFloor);
+					contact.reproject(cs); // kinematic law: the damped velocities meet the constraints again
+				}
 			}
 			if (in.mirrors) grid.unfoldMirrors(grid.nodes), grid.unfoldMirrors(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
 			stampTime(t[3]);

@@ -168,7 +168,11 @@ public:
 			if (wk.skip) continue;
 			if (g.params.law == ContactLaw::Kinematic) { // KinematicContact.hpp
 				MPM_ONE_THREAD
-				applyKinematic(grid, P, sched, offs, g, wk, dt, massFloor, err);
+				{
+					collectKinematic(grid, P, sched, offs, gi, wk, dt, massFloor, err);
+					solveKinematic(grid, gi);
+					kinematicReactions(gi, dt, 1);
+				}
 				MPM_ONE_THREAD_END
 				continue;
 			}
@@ -409,19 +413,28 @@ private:
 		return g.params.autoD0 ? 0.5 * e : g.params.d0;
 	}
 	// ---------------------------------------------------------------- kinematic law (KinematicContact.hpp), one thread
-	std::vector<KinematicContactRec<D>> kc; // the contacts of the group being processed (capacity kept between steps)
+	std::vector<std::vector<KinematicContactRec<D>>> kcs; // per group: its contacts this step (capacity kept between steps)
 	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
 	Vec bodyCompliance(const RigidPart<D>& q, const Vec& r, const Vec& e) const
 	{
 		if (!q.movable()) return Vec::Zero();
 		return e / q.mass + crossSpin<D>(SpinOf<D>(q.inverseInertia() * momentOf<D>(r, e)), r);
 	}
-	void applyKinematic(Grid<D>& grid, const Particles<D>& P, const BlockSchedule<D>& sched, const StencilOffsets<D>& offs, const RigidGroup<D>& g,
-	                    const Work& wk, Real dt, Real massFloor, ErrorRecord& err)
+	// 1. the contacting particles of the blocks near group gi's body, in block order
+	void collectKinematic(Grid<D>& grid, const Particles<D>& P, const BlockSchedule<D>& sched, const StencilOffsets<D>& offs, size_t gi,
+	                      const Work& wk, Real dt, Real massFloor, ErrorRecord& err)
 	{
 		MPM_IF_MPI(if (dd && dd->distributed()) { err.record(0, "is in a scene with a kinematic contact group, which MPI does not run yet (use law='penalty')"); return; })
+		if (kcs.size() < groups.size()) kcs.resize(groups.size());
+		const auto& g  = groups[gi];
+		auto&       kc = kcs[gi];
 		kc.clear();
-		// 1. the contacting particles of the blocks near the body, in block order
+		auto&        A  = nodeArr; // the nodal contact forces of the box, filled by kinematicReactions
+		const size_t nb = boxCount(wk.nlo, wk.nhi);
+		for (size_t j = 0; j < nb; ++j) {
+			const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
+			for (int a = 0; a < D; ++a) A.force[a][i] = 0;
+		}
 		IVec b;
 		for (int a = 0; a < D; ++a) b[a] = wk.blo[a];
 		while (true) {
@@ -441,16 +454,21 @@ private:
 					continue;
 				}
 				KinematicContactRec<D> c;
-				c.nn = 0, c.kinvGrid = 0;
+				c.nn = 0;
 				for (int n = 0; n < N; ++n) {
 					const size_t i = st.base + offs.off[n];
 					if (st.psi[n] == 0 || !(grid.nodes[i].m > massFloor)) continue;
 					c.node[c.nn] = i, c.psi[c.nn] = st.psi[n], c.psiOverM[c.nn] = st.psi[n] / grid.nodes[i].m;
-					c.kinvGrid += st.psi[n] * c.psiOverM[c.nn], ++c.nn;
+					++c.nn;
 				}
 				if (c.nn == 0) continue;
 				c.part = g.parts.size() == 1 ? g.parts[0] : h.part;
 				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
+				// Σ ψ_i²/m_i over the free components of the nodes, per axis (a boundary plane holds a component)
+				for (int a = 0; a < D; ++a) c.kinvAxis[a] = 0;
+				for (int k = 0; k < c.nn; ++k)
+					for (int a = 0; a < D; ++a)
+						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.psi[k] * c.psiOverM[k];
 				c.g    = (d0 - h.d) / dt;
 				c.cap0 = g.params.cohesion * (P.vol[p] / e) * dt;
 				c.lam.setZero();
@@ -463,29 +481,49 @@ private:
 			}
 			if (a == D) break;
 		}
-		// 2. projected Gauss–Seidel on the impulses (free parts' velocity changes in dq)
 		for (int p : g.parts) dq[p] = Motion {};
-		const Real mu = g.params.mu;
-		Real       scale = 0;
+	}
+	// 1/k of an impulse along unit e at contact c: Σ_a e_a² Σ_i ψ_i²/m_i (free components) + e·(W_B e).
+	Real kinematicCompliance(const KinematicContactRec<D>& c, const RigidPart<D>& q, const Vec& e) const
+	{
+		Real k = 0;
+		for (int a = 0; a < D; ++a) k += e[a] * e[a] * c.kinvAxis[a];
+		return k + e.dot(bodyCompliance(q, c.r, e));
+	}
+	// 2. projected Gauss–Seidel on the impulses of group gi (free parts' velocity changes in dq); continues from
+	// the impulses found so far, so a second call after the late damping restores the constraints.
+	void solveKinematic(Grid<D>& grid, size_t gi)
+	{
+		if (gi >= kcs.size()) return;
+		const auto& g  = groups[gi];
+		auto&       kc = kcs[gi];
+		const Real  mu = g.params.mu;
+		Real        scale = 0;
 		for (int sweep = 0; sweep < kinematicSweeps; ++sweep) {
 			Real worst = 0;
 			for (auto& c : kc) {
-				const auto& q = parts[c.part];
+				const auto& q  = parts[c.part];
 				Vec         vp = Vec::Zero();
 				for (int k = 0; k < c.nn; ++k)
 					for (int a = 0; a < D; ++a) vp[a] += c.psi[k] * grid.vel[c.node[k]].c[a];
 				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r);
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal
-				const Real kn   = 1 / (c.kinvGrid + c.n.dot(bodyCompliance(q, c.r, c.n)));
-				const Real ln0  = c.lam.dot(c.n);
-				const Real ln   = std::max(Real(0), ln0 + kn * (c.g - u.dot(c.n)));
-				// tangential: stop the slip with the grid's effective mass (the body's adds at most a few % near a light body)
-				const Vec  lt0  = c.lam - ln0 * c.n;
-				const Vec  ut   = u - u.dot(c.n) * c.n;
-				Vec        lt   = lt0 - ut / (c.kinvGrid + (ut.norm() > 0 ? ut.normalized().dot(bodyCompliance(q, c.r, ut.normalized())) : 0));
-				const Real cap  = mu * ln + c.cap0;
-				const Real ltn  = lt.norm();
+				const Real kinvN = kinematicCompliance(c, q, c.n);
+				if (!(kinvN > 0)) continue; // every stencil component held by boundary planes
+				const Real ln0 = c.lam.dot(c.n);
+				const Real ln  = std::max(Real(0), ln0 + (c.g - u.dot(c.n)) / kinvN);
+				// tangential: stop the slip with the effective mass of its direction
+				const Vec  lt0 = c.lam - ln0 * c.n;
+				const Vec  ut  = u - u.dot(c.n) * c.n;
+				const Real utn = ut.norm();
+				Vec        lt  = lt0;
+				if (utn > 0) {
+					const Real kinvT = kinematicCompliance(c, q, ut / utn);
+					if (kinvT > 0) lt -= ut / kinvT;
+				}
+				const Real cap = mu * ln + c.cap0;
+				const Real ltn = lt.norm();
 				if (ltn > cap) lt *= cap / ltn; // slip at the limit (Eq. 24)
 				const Vec lam = ln * c.n + lt;
 				const Vec dl  = lam - c.lam;
@@ -501,19 +539,19 @@ private:
 					dq[c.part].v -= dl / q.mass;
 					dq[c.part].w -= SpinOf<D>(q.inverseInertia() * momentOf<D>(c.r, dl));
 				}
-				worst = std::max(worst, dl.norm() * c.kinvGrid);
+				worst = std::max(worst, dl.norm() * kinvN);
 			}
 			if (worst <= kinematicTol * (scale + 1e-12)) break;
 		}
-		// 3. reactions (−λ/Δt at x_p) and the nodal contact forces Σ_p ψ_i λ_p/Δt, in contact order
-		auto&        A  = nodeArr;
-		const size_t nb = boxCount(wk.nlo, wk.nhi);
-		for (size_t j = 0; j < nb; ++j) {
-			const size_t i = boxNode(grid, wk.nlo, wk.nhi, j);
-			for (int a = 0; a < D; ++a) A.force[a][i] = 0;
-		}
-		for (const auto& c : kc) {
-			const Vec f = c.lam / dt;
+	}
+	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_p ψ_i λ_p/Δt, in contact order
+	// (sign −1 takes back what an earlier call reported, before the re-projection after the late damping).
+	void kinematicReactions(size_t gi, Real dt, int sign)
+	{
+		if (gi >= kcs.size()) return;
+		auto& A = nodeArr;
+		for (const auto& c : kcs[gi]) {
+			const Vec f = (sign / dt) * c.lam;
 			auto&     q = parts[c.part];
 			q.force -= f;
 			q.torque -= momentOf<D>(c.r, f);
@@ -521,6 +559,27 @@ private:
 				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.psi[k] * f[a];
 		}
 	}
+public:
+	// Some kinematic group has work this step (set by beforeTransfer).
+	bool hasKinematic() const
+	{
+		for (size_t gi = 0; gi < groups.size(); ++gi)
+			if (groups[gi].params.law == ContactLaw::Kinematic && gi < work.size() && !work[gi].skip) return true;
+		return false;
+	}
+	// After the late damping (dampAfterContact), serial: the kinematic groups project again, so the damped velocities
+	// still meet the constraints, and report the total impulse.
+	void reprojectKinematic(Grid<D>& grid, Real dt)
+	{
+		for (size_t gi = 0; gi < groups.size(); ++gi) {
+			if (groups[gi].params.law != ContactLaw::Kinematic || work[gi].skip) continue;
+			kinematicReactions(gi, dt, -1);
+			solveKinematic(grid, gi);
+			kinematicReactions(gi, dt, 1);
+		}
+	}
+
+private:
 
 	std::vector<QMat> Aq; // per part: A of bodyResponse
 	std::vector<QVec> bq; // per part: b (+ c) of bodyResponse
