@@ -98,6 +98,34 @@ public:
 		for (const auto& m : list)
 			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * m.stride, col + size_t(kp) * m.stride, m.axis); });
 	}
+	// The nodes of the modelled region that receive a particle's contribution to node i in the mirror-symmetric
+	// full-space problem (what fold does to the nodal sums): f(j, sign) for node i itself if it is not beyond a plane,
+	// and for every reflection of i across planes within 2 cells that lands in the modelled region, sign[a] = −1 for
+	// an odd number of reflections along a (a node on a plane receives its own reflection too).
+	template <class G, class F>
+	void receivers(const G& g, size_t i, F&& f) const
+	{
+		const IVec   c0 = g.coords(i);
+		const size_t nm = list.size();
+		for (size_t mask = 0; mask < (size_t(1) << nm); ++mask) {
+			IVec c  = c0;
+			int  sg[D];
+			for (int a = 0; a < D; ++a) sg[a] = 1;
+			bool ok = true;
+			for (size_t k = 0; k < nm && ok; ++k) {
+				if (!((mask >> k) & 1)) continue;
+				const Mirror& m  = list[k];
+				const int     d2 = 2 * c[m.axis] - m.twoP;
+				ok = d2 > -4 && d2 < 4 && m.twoP - c[m.axis] >= 0 && m.twoP - c[m.axis] < m.nStored;
+				c[m.axis] = m.twoP - c[m.axis], sg[m.axis] = -sg[m.axis];
+			}
+			for (size_t k = 0; k < nm && ok; ++k) ok = list[k].side * (2 * c[list[k].axis] - list[k].twoP) <= 0;
+			if (!ok) continue;
+			size_t j = 0;
+			for (int a = 0; a < D; ++a) j += size_t(c[a]) * g.stride[a];
+			f(j, sg);
+		}
+	}
 	// Share of the node at c in the modelled region: 0 beyond a plane (an image), 1/2 for each plane it
 	// lies on (its content includes the reflected half), else 1.
 	Real share(const IVec& c) const

@@ -171,7 +171,7 @@ public:
 				{
 					collectKinematic(grid, P, sched, offs, gi, wk, dt, massFloor, err);
 					solveKinematic(grid, gi);
-					kinematicReactions(gi, dt, 1);
+					kinematicReactions(grid, gi, dt, 1);
 				}
 				MPM_ONE_THREAD_END
 				continue;
@@ -455,20 +455,32 @@ private:
 				}
 				KinematicContactRec<D> c;
 				c.nn = 0;
+				auto addNode = [&](size_t i, const int* sg, Real psi) {
+					if (!(grid.nodes[i].m > massFloor)) return;
+					int k = 0;
+					while (k < c.nn && c.node[k] != i) ++k; // a node reached twice (directly and as an image): one entry
+					if (k == c.nn) {
+						if (c.nn == N) return; // cannot happen: at most 4^D distinct nodes of the modelled region
+						c.node[k] = i, c.invM[k] = 1 / grid.nodes[i].m, ++c.nn;
+						for (int a = 0; a < D; ++a) c.w[k][a] = 0;
+					}
+					for (int a = 0; a < D; ++a) c.w[k][a] += sg[a] * psi;
+				};
+				const int one[3] = { 1, 1, 1 };
 				for (int n = 0; n < N; ++n) {
+					if (st.psi[n] == 0) continue;
 					const size_t i = st.base + offs.off[n];
-					if (st.psi[n] == 0 || !(grid.nodes[i].m > massFloor)) continue;
-					c.node[c.nn] = i, c.psi[c.nn] = st.psi[n], c.psiOverM[c.nn] = st.psi[n] / grid.nodes[i].m;
-					++c.nn;
+					if (!grid.hasMirrors()) addNode(i, one, st.psi[n]);
+					else grid.mirrors.receivers(grid, i, [&](size_t j, const int* sg) { addNode(j, sg, st.psi[n]); });
 				}
 				if (c.nn == 0) continue;
 				c.part = g.parts.size() == 1 ? g.parts[0] : h.part;
 				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
-				// Σ ψ_i²/m_i over the free components of the nodes, per axis (a boundary plane holds a component)
+				// Σ w²/m over the free components of the nodes, per axis (a boundary plane holds a component)
 				for (int a = 0; a < D; ++a) c.kinvAxis[a] = 0;
 				for (int k = 0; k < c.nn; ++k)
 					for (int a = 0; a < D; ++a)
-						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.psi[k] * c.psiOverM[k];
+						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.w[k][a] * c.w[k][a] * c.invM[k];
 				c.g    = (d0 - h.d) / dt;
 				c.cap0 = g.params.cohesion * (P.vol[p] / e) * dt;
 				c.lam.setZero();
@@ -481,6 +493,9 @@ private:
 			}
 			if (a == D) break;
 		}
+		for (const auto& c : kc) // nodes of the records outside the box (partners of images)
+			for (int k = 0; k < c.nn; ++k)
+				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] = 0;
 		for (int p : g.parts) dq[p] = Motion {};
 	}
 	// 1/k of an impulse along unit e at contact c: Σ_a e_a² Σ_i ψ_i²/m_i (free components) + e·(W_B e).
@@ -505,7 +520,7 @@ private:
 				const auto& q  = parts[c.part];
 				Vec         vp = Vec::Zero();
 				for (int k = 0; k < c.nn; ++k)
-					for (int a = 0; a < D; ++a) vp[a] += c.psi[k] * grid.vel[c.node[k]].c[a];
+					for (int a = 0; a < D; ++a) vp[a] += c.w[k][a] * grid.vel[c.node[k]].c[a];
 				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r);
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal
@@ -533,7 +548,7 @@ private:
 					const size_t  i   = c.node[k];
 					const uint8_t fix = grid.fixMask[i];
 					for (int a = 0; a < D; ++a)
-						if (!((fix >> a) & 1)) grid.vel[i].c[a] += c.psiOverM[k] * dl[a];
+						if (!((fix >> a) & 1)) grid.vel[i].c[a] += c.w[k][a] * c.invM[k] * dl[a];
 				}
 				if (q.movable()) { // the free body takes −Δλ at x_p
 					dq[c.part].v -= dl / q.mass;
@@ -544,21 +559,23 @@ private:
 			if (worst <= kinematicTol * (scale + 1e-12)) break;
 		}
 	}
-	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_p ψ_i λ_p/Δt, in contact order
+	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_k w_k ∘ λ/Δt, in contact order
 	// (sign −1 takes back what an earlier call reported, before the re-projection after the late damping).
-	void kinematicReactions(size_t gi, Real dt, int sign)
+	void kinematicReactions(const Grid<D>&, size_t gi, Real dt, int sign)
 	{
 		if (gi >= kcs.size()) return;
 		auto& A = nodeArr;
 		for (const auto& c : kcs[gi]) {
+			// the body takes −λ/Δt at x_p (its images' share is theirs); the nodal forces Σ_k w_k ∘ λ/Δt
 			const Vec f = (sign / dt) * c.lam;
-			auto&     q = parts[c.part];
+			for (int k = 0; k < c.nn; ++k)
+				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.w[k][a] * f[a];
+			auto& q = parts[c.part];
 			q.force -= f;
 			q.torque -= momentOf<D>(c.r, f);
-			for (int k = 0; k < c.nn; ++k)
-				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.psi[k] * f[a];
 		}
 	}
+
 public:
 	// Some kinematic group has work this step (set by beforeTransfer).
 	bool hasKinematic() const
@@ -573,9 +590,9 @@ public:
 	{
 		for (size_t gi = 0; gi < groups.size(); ++gi) {
 			if (groups[gi].params.law != ContactLaw::Kinematic || work[gi].skip) continue;
-			kinematicReactions(gi, dt, -1);
+			kinematicReactions(grid, gi, dt, -1);
 			solveKinematic(grid, gi);
-			kinematicReactions(gi, dt, 1);
+			kinematicReactions(grid, gi, dt, 1);
 		}
 	}
 
