@@ -9,8 +9,8 @@ namespace mpm {
 // How the contact keeps particles out of a rigid body (doc/contact.md, "Contact laws").
 enum class ContactLaw : int {
 	Kinematic = 0, // impulses at the contacting particles: no approach, residual overlap closed in one step, Coulomb +
-	               // cohesion as an impulse limit; the Δt → 0 limit of Eq. 23 reached at any Δt (KinematicContact.hpp)
-	Penalty   = 1  // Eq. 23 exactly as printed: f = (1 − χ) κ_p (d0 − d_p) n_p, κ_p = 2 m_p/Δt² (the paper's; default)
+	               // cohesion as an impulse limit; the Δt → 0 limit of Eq. 23 reached at any Δt (KinematicContact.hpp; default)
+	Penalty   = 1  // Eq. 23 exactly as printed: f = (1 − χ) κ_p (d0 − d_p) n_p, κ_p = 2 m_p/Δt² (the paper's, a named option)
 };
 MPM_CHOICES(ContactLaw, "kinematic|penalty")
 } // namespace mpm
@@ -25,9 +25,10 @@ MPM_CHOICES(ContactLaw, "kinematic|penalty")
 // domain, e.g. a flaw filler, touches the material around it at zero force from t = 0), every other particle
 // keeps the autoD0/d0 value. First layer: d_p(0) < e_p max_i |n_i| (ContactGroups::captureInitialD0).
 #define MPM_CONTACT_PARAMS(X)                                                                                                     \
-	X(ContactLaw, law, ContactLaw::Penalty, "-", 0, 1, CC, "",                                                                 \
-	  "'penalty' (default): Eq. 23 as printed, κ_p = 2 m_p/Δt² (a contact compliance that grows with Δt²); "              \
-	  "'kinematic': no-penetration impulses at the contacting particles (projected Gauss–Seidel), independent of Δt", "Eqs. 23–26", "")         \
+	X(ContactLaw, law, ContactLaw::Kinematic, "-", 0, 1, CC, "",                                                               \
+	  "'kinematic' (default): no-penetration impulses at the contacting particles (projected Gauss–Seidel), the Δt → 0 "    \
+	  "limit of Eq. 23 at any Δt; 'penalty': Eq. 23 as printed, κ_p = 2 m_p/Δt² (the paper's; a contact compliance that "   \
+	  "grows with Δt²)", "Eqs. 23–26", "")                                                                                       \
 	X(Real, mu, 0, "-", 0, INFINITY, CO, "μ_con",                                                                                \
 	  "Coulomb friction coefficient of the contact (ym.RigidBodies/DemSpheres.add without mu: tan(frictionAngle) of the "     \
 	  "body's YADE FrictMat)", "Eq. 24", "")                                                                                     \

@@ -28,22 +28,25 @@ constexpr Real kinematicTouch = 1e-3;
 constexpr int  kinematicSweeps = 60;
 constexpr Real kinematicTol    = 1e-6;
 
-// One contacting particle of a kinematic group. Its stencil is resolved to nodes of the modelled region: a node
-// beyond a symmetry plane is its partner with the reflection folded into the per-axis weight (Grid::mirrors), so
-// w[k][a] = Σ ψ_i sign_i[a] over the stencil nodes i that are node[k] or its images (ψ_i without planes).
+// One contacting particle of a kinematic group, its stencil resolved to nodes of the modelled region (symmetry
+// planes, Grid::mirrors): the particle reads v_i of a node beyond a plane as the reflection of its partner
+// (rd: Σ ψ_i sign_i over the stencil nodes i whose source is node[k]), and its impulse reaches node[k] as fold
+// sums it, from the particle and from its images (w: a node on a plane also takes its own reflection). Without
+// planes rd = w = ψ.
 template <int D>
 struct KinematicContactRec {
 	using Vec = typename Dim<D>::Vec;
 	static constexpr int N = Dim<D>::nStencil;
 	size_t node[N]; // distinct nodes of the modelled region (count nn)
-	Real   w[N][D]; // per-axis weight of node[k] in the particle's velocity, v_p[a] = Σ_k w[k][a] v[node k][a]
+	Real   rd[N][D]; // per-axis weight of node[k] in the particle's velocity, v_p[a] = Σ_k rd[k][a] v[node k][a]
+	Real   w[N][D]; // per-axis weight of node[k] in the particle's impulse, Δv[node k][a] = w[k][a] λ[a]/m_k
 	Real   invM[N]; // 1/m of node[k] [1/kg]
 	int    nn;
 	int    part;
 	Vec    x, n, r;  // particle position, contact normal, lever arm x_p − c
 	Real   g;        // target normal rate (d0 − d_p)/Δt [m/s]
 	Real   cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
-	Vec    kinvAxis; // Σ_k w[k][a]²/m_k over the nodes whose component a is free [1/kg]
+	Vec    kinvAxis; // Σ_k rd[k][a] w[k][a]/m_k over the nodes whose component a is free [1/kg]
 	Vec    lam;      // impulse on the particle [N s]
 };
 

@@ -455,32 +455,45 @@ private:
 				}
 				KinematicContactRec<D> c;
 				c.nn = 0;
-				auto addNode = [&](size_t i, const int* sg, Real psi) {
-					if (!(grid.nodes[i].m > massFloor)) return;
+				auto entry = [&](size_t i) -> int { // node i's entry (−1: too light to carry a velocity)
+					if (!(grid.nodes[i].m > massFloor)) return -1;
 					int k = 0;
 					while (k < c.nn && c.node[k] != i) ++k; // a node reached twice (directly and as an image): one entry
 					if (k == c.nn) {
-						if (c.nn == N) return; // cannot happen: at most 4^D distinct nodes of the modelled region
+						if (c.nn == N) return -1; // cannot happen: at most 4^D distinct nodes of the modelled region
 						c.node[k] = i, c.invM[k] = 1 / grid.nodes[i].m, ++c.nn;
-						for (int a = 0; a < D; ++a) c.w[k][a] = 0;
+						for (int a = 0; a < D; ++a) c.rd[k][a] = c.w[k][a] = 0;
 					}
-					for (int a = 0; a < D; ++a) c.w[k][a] += sg[a] * psi;
+					return k;
 				};
-				const int one[3] = { 1, 1, 1 };
 				for (int n = 0; n < N; ++n) {
-					if (st.psi[n] == 0) continue;
+					const Real psi = st.psi[n];
+					if (psi == 0) continue;
 					const size_t i = st.base + offs.off[n];
-					if (!grid.hasMirrors()) addNode(i, one, st.psi[n]);
-					else grid.mirrors.receivers(grid, i, [&](size_t j, const int* sg) { addNode(j, sg, st.psi[n]); });
+					if (!grid.hasMirrors()) {
+						const int k = entry(i);
+						if (k >= 0)
+							for (int a = 0; a < D; ++a) c.rd[k][a] += psi, c.w[k][a] += psi;
+						continue;
+					}
+					int       sg[D];
+					const int k = entry(grid.mirrors.source(grid, i, sg));
+					if (k >= 0)
+						for (int a = 0; a < D; ++a) c.rd[k][a] += sg[a] * psi;
+					grid.mirrors.receivers(grid, i, [&](size_t j, const int* sj) {
+						const int kj = entry(j);
+						if (kj >= 0)
+							for (int a = 0; a < D; ++a) c.w[kj][a] += sj[a] * psi;
+					});
 				}
 				if (c.nn == 0) continue;
 				c.part = g.parts.size() == 1 ? g.parts[0] : h.part;
 				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
-				// Σ w²/m over the free components of the nodes, per axis (a boundary plane holds a component)
+				// Σ rd·w/m over the free components of the nodes, per axis (a boundary plane holds a component)
 				for (int a = 0; a < D; ++a) c.kinvAxis[a] = 0;
 				for (int k = 0; k < c.nn; ++k)
 					for (int a = 0; a < D; ++a)
-						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.w[k][a] * c.w[k][a] * c.invM[k];
+						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.rd[k][a] * c.w[k][a] * c.invM[k];
 				c.g    = (d0 - h.d) / dt;
 				c.cap0 = g.params.cohesion * (P.vol[p] / e) * dt;
 				c.lam.setZero();
@@ -520,7 +533,7 @@ private:
 				const auto& q  = parts[c.part];
 				Vec         vp = Vec::Zero();
 				for (int k = 0; k < c.nn; ++k)
-					for (int a = 0; a < D; ++a) vp[a] += c.w[k][a] * grid.vel[c.node[k]].c[a];
+					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * grid.vel[c.node[k]].c[a];
 				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r);
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal

@@ -77,7 +77,7 @@ def _slab_on_block(d0, gap, l=0.02, chi=0.5):
     s = ym.make_solver((0, 0), (0.2, 0.2), l)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (0.2, 0.1), ppc=2)
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0))
+    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0, law="penalty"))
     s.addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
     s.setRigidPartState(p, (0.1, 0.1 + gap + 0.02), np.eye(2), (0, 0), 0.0)
     if d0 == "initial":
@@ -155,11 +155,11 @@ def _column(d0, v=0.05, u_end=3e-4, l=0.01, W=0.02, H=0.1, cut=(8, 12), gap=0.3)
     s.addBoundaryPlane(0, -1, 0.0, "slip"), s.addBoundaryPlane(0, 1, W, "slip"), s.addBoundaryPlane(1, -1, 0.0, "slip")
     O.reset()
     rb = ym.RigidBodies(s)
-    platen = cases.yade_platen(rb, W / 2, H, W, l, v, 0.0)
+    platen = cases.yade_platen(rb, W / 2, H, W, l, v, 0.0, law="penalty")
     sid = O.bodies.append(utils.box((W / 2, 0.5 * (y_lo + y_hi), 0), (W / 2, 0.5 * (y_hi - y_lo) - gap * dp, 0.5),
                                     fixed=False, material=FrictMat(density=rho)))
     O.bodies[sid].state.blockedDOFs = "xzXYZ"
-    rb.add(sid, mu=0.0, d0=d0)
+    rb.add(sid, mu=0.0, d0=d0, law="penalty")
     cases.yade_engines(s, rb, "column")
     import builtins
     from yade.wrapper import PyRunner

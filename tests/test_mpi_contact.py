@@ -30,13 +30,13 @@ ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0
 s.addBoundaryPlane(0, -1, 0.0, "slip")          # a symmetry plane normal to x; no floor: the block falls freely
 O.reset()
 rb = RigidBodies(s)
-top = yade_platen(rb, W / 2, H, W, l, 6.0, 0.3)                 # down at 6 m/s, μ = 0.3
+top = yade_platen(rb, W / 2, H, W, l, 6.0, 0.3, law="penalty")               # down at 6 m/s, μ = 0.3
 hp = 5 * l                                                       # right platen: left at 0.5 m/s, μ = 0.2, full height
 right = O.bodies.append(utils.box((W + hp, H / 2, 0), (hp, 0.6 * H, 0.5), fixed=False))
 O.bodies[right].state.blockedDOFs = "xyzXYZ"
 O.bodies[right].state.vel = (-0.5, 0, 0)
-rb.add(right, mu=0.2)
-filler = yade_filler(rb, slot, 0.6, density=2000.0)            # free in the plane, d0 = "initial"
+rb.add(right, mu=0.2, law="penalty")
+filler = yade_filler(rb, slot, 0.6, density=2000.0, law="penalty")            # free in the plane, d0 = "initial"
 eng = yade_engines(s, rb, "mpm")
 v = s.view("v1"); v[:] = -5.0; del v                             # falling: particles cross y = 0.14
 s.requestSort()

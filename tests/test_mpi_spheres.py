@@ -37,7 +37,7 @@ for (x, y, vx, vy) in ((0.1, 0.15, 6.0, -3.0), (0.05, 0.336, 0.0, -6.0), (0.16, 
     b.state.vel = (vx, vy, 0.0)
     ids.append(O.bodies.append(b))
 sp = ym.DemSpheres(s)
-sp.add(ids, mu=0.3)
+sp.add(ids, mu=0.3, law="penalty")
 O.engines = [ForceResetter(), ym.MpmEngine(s, bodies=sp).runner(), NewtonIntegrator(gravity=(0, -9.81, 0))]
 O.dt = s.stableDt()
 sched, impulse = [], np.zeros((len(ids), 2))

@@ -29,14 +29,18 @@ def test_disc_volume_and_frame():
     assert prism3d.disc_coordinates(side[None], fl)[1][0] == pytest.approx(90)
 
 
+@pytest.mark.parametrize("law, rtol", [("penalty", 1e-9), ("kinematic", 2e-4)])
 @pytest.mark.parametrize("h, steps, models", [(0.004, 40, ("z",)), (0.0025, 15, ("z", "xz"))])
-def test_symmetric_models_match_the_whole_prism(h, steps, models):
+def test_symmetric_models_match_the_whole_prism(h, steps, models, law, rtol):
+    # penalty (a per-particle force): the same numbers to roundoff. kinematic: the impulses of the platen's contact
+    # layer come from an iterative solve (projected Gauss–Seidel to 1e-6 of the contact speed) whose sweep order
+    # differs between the models: measured 8.8e-5 (z, 4 mm).
     # the quarter (xz) is checked on the run's grid, 2.5 mm: on a 4 mm grid (5 cells between its plane and the free
     # face) it differs from the whole prism by 2 % from the second step (doc/three_d.md, not understood)
     from yade import O
     rec = {}
     for sym in ("none",) + models:
-        s, sc = prism3d.penny_prism("intact", h, symmetry=sym)
+        s, sc = prism3d.penny_prism("intact", h, symmetry=sym, contact_law=law)
         rec[sym] = []
         for _ in range(steps):
             O.step()
@@ -45,7 +49,7 @@ def test_symmetric_models_match_the_whole_prism(h, steps, models):
         assert s.numParticles == round(8 * 0.04 * 0.08 * 0.04 / h ** 3) // {"none": 1, "z": 2, "xz": 4}[sym]
     assert rec["none"][-1] > 1e5
     for sym in models:
-        np.testing.assert_allclose(rec[sym], rec["none"], rtol=1e-9, atol=1e-9 * rec["none"].max())
+        np.testing.assert_allclose(rec[sym], rec["none"], rtol=rtol, atol=rtol * rec["none"].max())
 
 
 def test_penny_prism_bad_input():

@@ -23,21 +23,29 @@ def _run(variant, h, cells, steps, **kw):
     return s, sc, np.array(curve).T
 
 
-def test_slab_is_plane_strain_to_roundoff():
+@pytest.mark.parametrize("law, tol", [("penalty", 1e-10), ("kinematic", 2e-5)])
+def test_slab_is_plane_strain_to_roundoff(law, tol):
+    """penalty: to roundoff; kinematic: the platen layer's impulses come from an iterative solve (projected
+    Gauss–Seidel to 1e-6 of the contact speed) whose sweep order differs between 2D and the slab: measured 4.3e-6."""
     h, cells = 0.004, 2                        # the coarsest grid the 2 mm flaw allows
-    s2, _, c2 = _run("open", h, 0, 60, platen_d0=h / 4)
-    s3, sc3, c3 = _run("open", h, cells, 60, platen_d0=h / 4)
+    s2, _, c2 = _run("open", h, 0, 60, platen_d0=h / 4, contact_law=law)
+    s3, sc3, c3 = _run("open", h, cells, 60, platen_d0=h / 4, contact_law=law)
     assert sc3["thickness"] == pytest.approx(cells * h) and s3.numParticles == 2 * cells * s2.numParticles
     assert c2[1, -1] > 1e5                    # the platen is pushing
-    np.testing.assert_allclose(c3, c2, rtol=1e-10, atol=1e-10 * np.abs(c2[1]).max())
+    np.testing.assert_allclose(c3, c2, rtol=tol, atol=tol * np.abs(c2[1]).max())
     v2, v3 = ym.get(s2, "vel"), ym.get(s3, "vel")
     x3 = ym.get(s3, "pos")
     nz = 2 * cells                             # particle ids: z fastest (geometry.fill_region)
+    dv, dz = [], []
     for j in range(nz):
         layer = slice(j, None, nz)
-        assert np.abs(v3[layer, :2] - v2).max() < 1e-10 * np.abs(v2).max()
-        assert np.ptp(x3[layer, 2]) < 1e-12
-    assert np.abs(v3[:, 2]).max() < 1e-10 * np.abs(v2).max()   # no motion across the slip planes
+        dv.append(np.abs(v3[layer, :2] - v2).max() / np.abs(v2).max())
+        dz.append(np.ptp(x3[layer, 2]))
+    vz = np.abs(v3[:, 2]).max() / np.abs(v2).max()
+    print(f"{law}: curve {np.abs(c3 - c2).max() / np.abs(c2[1]).max():.2e}, layer velocities {max(dv):.2e}, z spread {max(dz):.2e} m, vz {vz:.2e}")
+    assert max(dv) < 1e-10 if law == "penalty" else max(dv) < 1e-4
+    assert max(dz) < 1e-12 if law == "penalty" else max(dz) < 1e-9
+    assert vz < 1e-10 if law == "penalty" else vz < 1e-4       # no motion across the slip planes
 
 
 def test_slab_modulus_and_curve_within_two_percent():

@@ -40,8 +40,8 @@ table in doc/contact.md). Every keyword is checked before any work; NumPy scalar
             first lattice layer next to the body when ``add`` registers it get d0 = their initial distance to
             its surface (a body filling a domain, e.g. a flaw filler); the body must not overlap any particle
             centre (ValueError).
-  law       "penalty" (default): the paper's Eq. 23 as printed (κ = 2m/Δt²; chi applies to it only);
-            "kinematic": no-penetration impulses at the contacting particles, results independent of Δt
+  law       "kinematic" (default): no-penetration impulses at the contacting particles, results independent of
+            Δt; "penalty": the paper's Eq. 23 as printed (κ = 2m/Δt²; chi applies to it only)
             (doc/contact.md, "Contact laws").
   cohesion, chi: given or the declared defaults.
 """

@@ -31,14 +31,15 @@ def penny_flaw(size=PRISM_SIZE, flaw=UNIAXIAL_FLAW, specimen_width=UNIAXIAL_WIDT
 
 
 def penny_prism(variant, spacing, symmetry="none", ppc=2, material=None, platen_speed=PLATEN_SPEED, label="mpm",
-                size=PRISM_SIZE, side_room=PRISM_SIDE_ROOM, flaw_nodes="excluded"):
+                size=PRISM_SIZE, side_room=PRISM_SIDE_ROOM, flaw_nodes="excluded", contact_law=None):
     """The prism [0, W] × [0, H] × [0, D] (size) of ``rocks.miao2018_sandstone()`` (or `material`) on a
     free-slip base y = 0, loaded by the rigid frictionless YADE platen of ``uniaxial_flaw`` (moving down at
     `platen_speed` [m/s]); variant "penny": the disc flaw of ``penny_flaw`` cut out (an open flaw: its nodes
     excluded from the fits), "intact": none. symmetry: "none" (the whole prism), "z" (the half z ≥ D/2 with
     a slip plane on z = D/2: the disc's plane of symmetry), "xz" (intact only: the quarter x ≥ W/2, z ≥ D/2).
     flaw_nodes: "excluded" (default: the grid nodes inside the disc out of the fits, as the 2D open flaw) or "shared"
-    (only the particles removed; the paper's construction, ``add_region(gap_nodes="shared")``).
+    (only the particles removed; the paper's construction, ``add_region(gap_nodes="shared")``). contact_law: the
+    platen's contact law, "kinematic" or "penalty" (None: the declared default).
     Returns (solver, scene) with scene = dict(platen, rigid, engine, flaw (penny_flaw dict or None), size,
     modelled (the modelled part's lo, hi), axial_stress() [Pa, compression positive: the platen reaction over
     the modelled cross-section], axial_strain() [-])."""
@@ -77,7 +78,7 @@ def penny_prism(variant, spacing, symmetry="none", ppc=2, material=None, platen_
         exclude_nodes_inside(s, flaw["disc"])
     O.reset()
     rb = RigidBodies(s)
-    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, PLATEN_FRICTION)
+    platen = yade_platen(rb, W / 2, H, W, spacing, platen_speed, PLATEN_FRICTION, law=contact_law)
     eng = yade_engines(s, rb, label)
     y0 = O.bodies[platen].state.pos[1]
     area = (hi[0] - lo[0]) * (hi[2] - lo[2])
