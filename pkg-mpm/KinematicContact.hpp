@@ -1,4 +1,5 @@
-// The kinematic contact law (ContactLaw::Kinematic, a named option beside Eq. 23's penalty; doc/contact.md "Contact laws"): the Δt → 0
+// The kinematic contact law (ContactLaw::Kinematic, the default; Eq. 23's penalty is the named option beside it;
+// doc/contact.md "Contact laws"): the Δt → 0
 // limit of Eq. 23 — a non-penetrating frictional contact at the particles' faces — reached at any Δt by
 // constraining velocities instead of pushing with a penalty spring whose compliance grows with Δt².
 //
@@ -13,7 +14,8 @@
 // body receives −λ_p/Δt at x_p: momentum conserved to round-off; Σ_i ψ_i x_i = x_p: the moment acts at x_p).
 // The particles share nodes, so the impulses are found together by projected Gauss–Seidel over the contacts in
 // a fixed order (deterministic, serial), each update with the effective mass of its direction,
-//   1/k = Σ_i ψ_i²/m_i + e·(W_B e)  (W_B: the free body's inverse mass and inertia at r_p; 0 if prescribed),
+//   1/k = Σ_a e_a² Σ_i ψ_i²/m_i + e·(W_B e)  (i over the nodes whose component a is free; W_B: the free body's inverse
+//   mass and inertia at r_p, 0 if prescribed),
 // λ_n clamped ≥ 0 and λ_t to the Coulomb + cohesion disc; a free body's velocity is updated with each impulse
 // (−W_B J_pᵀ Δλ), so it takes its share of every exchange.
 #pragma once

@@ -191,7 +191,7 @@ class RigidBodies:
         residual penetration factor chi [-] and detection distance d0 (None: half the particle edge; a number
         [m] up to one grid spacing; "initial": the first particle layer's distance to the body now); ranges
         and defaults: ``ym.ContactParams`` (module docstring). thickness [m] overrides the 2D z-extent. law:
-        "penalty" (default, Eq. 23 as printed) or "kinematic" (independent of Δt).
+        "kinematic" (default, independent of Δt) or "penalty" (Eq. 23 as printed).
         Everything is checked before the solver changes. Returns the group index."""
         ids = body_ids(ids)
         check_thickness(thickness)
