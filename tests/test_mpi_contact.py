@@ -87,3 +87,38 @@ def test_bodies_two_ranks_match_one(tmp_path):
     assert rel <= 1e-10 and rel_f.max() <= 1e-10 and rel_fill <= 1e-10
     assert np.abs(fill2[:3] - fill1[:3]).max() <= 1e-13
     assert float(parts[0]["time"][0]) == pytest.approx(float(ref[0]["time"][0]), rel=1e-12)
+
+
+REFUSE = r"""
+import sys
+import numpy as np
+import yade_mpm as ym
+import yade_mpm.parallel
+from yade import O, utils
+from yade_mpm.bodies import RigidBodies
+steps, out = int(sys.argv[1]), sys.argv[2]
+s = ym.make_solver((0.0, 0.0), (0.2, 0.32), 0.01, margin=2)
+ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0.0), (0.2, 0.2))
+O.reset()
+rb = RigidBodies(s)
+box = O.bodies.append(utils.box((0.1, 0.25, 0), (0.1, 0.02, 0.5), fixed=True))
+try:
+    rb.add(box, mu=0.3)                         # the default law: kinematic
+    msg = "accepted"
+except ValueError as e:
+    msg = str(e)
+box2 = O.bodies.append(utils.box((0.1, 0.29, 0), (0.1, 0.01, 0.5), fixed=True))
+rb.add(box2, mu=0.3, law="penalty")             # the named option runs
+np.savez(f"{out}.{ym.parallel.rank()}.npz", msg=msg, active=s.contactActive, groups=s.numContactGroups)
+"""
+
+
+def test_kinematic_law_is_refused_at_registration_on_several_ranks(tmp_path):
+    """Several MPI ranks do not run the kinematic law yet: registering a body with it is refused before anything is
+    added, naming the parameter and the option that runs (law='penalty'); one process accepts it."""
+    parts = run_child(tmp_path, REFUSE, "refuse.py", "mpi", 1, 2, 300)
+    for p in parts:
+        assert "law" in str(p["msg"]) and "penalty" in str(p["msg"]) and "kinematic" in str(p["msg"])
+        assert int(p["groups"]) == 1 and bool(p["active"])
+    one = run_child(tmp_path, REFUSE, "refuse.py", "one", 1, 1, 300)
+    assert str(one[0]["msg"]) == "accepted" and int(one[0]["groups"]) == 2
