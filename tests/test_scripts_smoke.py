@@ -3,6 +3,7 @@
 elsewhere: tunnel_spalling, uniaxial_flaw, circular_opening, penny_crack (test_courant, test_tunnel_script,
 test_case_results …), stability, report, study_report, sweep, fidelity_variants, bench, bench_kernel,
 regress (test_bad_input), mpi_run.sh (test_mpi)."""
+import csv
 import json
 import os
 import subprocess
@@ -105,3 +106,12 @@ def test_mpi_scripts_on_one_process(tmp_path):
     for mode in ("save", "resume"):
         ok(run("mpi_checkpoint_big.py", mode, "--out", tmp_path / "ck", "--cells", 6, 6, 6, "--steps", 2, env=mpi))
     assert "bitwise resume: True" in ok(run("mpi_checkpoint_big.py", "compare", "--out", tmp_path / "ck"))
+
+
+def test_pic_dissipation_small(tmp_path):
+    """One Courant number, one wavelength, 20 µs: the CSV row, and bad input named."""
+    ok(run("pic_dissipation.py", "--out", tmp_path, "--courant", "1", "--wavelengths", "25", "--time", "2e-5"))
+    rows = list(csv.DictReader(open(tmp_path / "pic_dissipation.csv")))
+    assert len(rows) == 1 and 0.9 < float(rows[0]["energy_left"]) < 1.0
+    r = run("pic_dissipation.py", "--out", tmp_path, "--courant", "2")
+    assert r.returncode == 2 and "--courant" in r.stderr
