@@ -187,13 +187,20 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d, law, down, lif
     assert checked >= 10
 
 
-@pytest.mark.parametrize("free", [False, True])
-def test_contact_is_bitwise_identical_for_1_and_2_threads(free):
-    """free: the incline is a free part (its mass and inertia set; the stick step's body response)."""
+@pytest.mark.parametrize("free, law, damping", [(False, "kinematic", 0.0), (True, "kinematic", 0.0), (True, "kinematic", 0.3),
+                                                (False, "penalty", 0.0), (True, "penalty", 0.3)])
+def test_contact_is_bitwise_identical_for_1_and_2_threads(free, law, damping, monkeypatch):
+    """free: the incline is a free part (its mass and inertia set; the stick step's body response); damping > 0: the
+    late damping (and the kinematic law's second projection)."""
+    orig = ym.contact_params
+    monkeypatch.setattr(ym, "contact_params", lambda *a, **k: orig(*a, law=law, **k))
+
     def run(n):
         ym.setThreads(n)
         try:
             s, *_ = _block_on_incline(2, np.radians(30), 0.3)
+            assert s.contactParams(0).law == law
+            s.damping = damping
             if free:
                 s.setRigidPartMass(0, 5.0, 0.5)
             for _ in range(150):
