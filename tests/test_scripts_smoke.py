@@ -115,3 +115,38 @@ def test_pic_dissipation_small(tmp_path):
     assert len(rows) == 1 and 0.9 < float(rows[0]["energy_left"]) < 1.0
     r = run("pic_dissipation.py", "--out", tmp_path, "--courant", "2")
     assert r.returncode == 2 and "--courant" in r.stderr
+
+
+def test_circular_opening_names_a_stopped_run_and_goes_on(tmp_path, monkeypatch):
+    """A spacing of the convergence ladder that the solver stops (here: run_case raises the solver's error for the coarse
+    spacing) is named under "stopped" with its message, the main run still runs and writes its results, exit status 1;
+    if the main run stops, summary.json still says why."""
+    import importlib.util
+    import yade_mpm as ym
+    spec = importlib.util.spec_from_file_location("circular_opening", os.path.join(SCRIPTS, "circular_opening.py"))
+    co = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(co)
+    real = co.run_case
+
+    def failing(bad):
+        def run_case(l, *a, **k):
+            if abs(l - bad) < 1e-12:
+                raise ym.MpmSimulationError(f"MPM stopped at step 7: test failure at l = {l}")
+            return real(l, *a, **k)
+        return run_case
+    args = ["--out", str(tmp_path / "a"), "--domain", "0.6", "--spacing", "0.05", "--convergence-spacings", "0.06", "0.05",
+            "--no-vtu", "--max-time", "0.002"]
+    monkeypatch.setattr(co, "run_case", failing(0.06))
+    with pytest.raises(SystemExit) as e:
+        co.main(args)
+    assert e.value.code == 1
+    s = json.load(open(tmp_path / "a" / "summary.json"))
+    assert [x["grid_spacing_m"] for x in s["stopped"]] == [0.06] and "test failure" in s["stopped"][0]["error"]
+    assert s["grid_spacing_m"] == 0.05 and [c["grid_spacing_m"] for c in s["convergence"]] == [0.05]
+    args[1] = str(tmp_path / "b")
+    monkeypatch.setattr(co, "run_case", failing(0.05))
+    with pytest.raises(SystemExit) as e:
+        co.main(args)
+    assert e.value.code == 1
+    s = json.load(open(tmp_path / "b" / "summary.json"))
+    assert [x["grid_spacing_m"] for x in s["stopped"]] == [0.05] and [c["grid_spacing_m"] for c in s["convergence"]] == [0.06]
