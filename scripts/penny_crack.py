@@ -18,7 +18,8 @@ regularised threshold), --flaws/--flaw-seed (flawCount/flawSeed, Benz–Asphaug 
 The paper ramps P over 0.5 s (≈ 160 k steps at l = 0.02 m). The load is quasi-static (the P-wave
 crosses the 5 m block in 1.5 ms), so by default the ramp is compressed to --ramp-time seconds and
 results are reported on the paper's time axis t_paper = t · 0.5 s / ramp-time (= the same pressure
-P(t)). `--full` runs the paper's 0.5 s ramp (hours). summary.json says which configuration ran.
+P(t)). `--full` runs the paper's 0.5 s ramp (hours). summary.json says which configuration ran; a run the solver
+stops is named under "stopped" with its message, the other runs still run, and the exit status is 1.
 
     /usr/bin/python3 scripts/penny_crack.py --out out/penny            # default
     /usr/bin/python3 scripts/penny_crack.py --out out/penny --full     # paper time scale
@@ -305,6 +306,9 @@ def main(argv=None):
         ap.error(f"--end-time must lie in (0, {PAPER_RAMP}] s")
     if not 0 < a.half_length < a.size / 4:
         ap.error(f"--half-length must lie in (0, size/4) = (0, {a.size / 4:g}) m")
+    for law in a.laws.split(","):
+        if law not in CHOICES["growthLaw"]:
+            ap.error(f"--laws: {law!r} is not one of {CHOICES['growthLaw']}")
     global HALF_CRACK
     HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
     global COURANT
@@ -327,8 +331,19 @@ def main(argv=None):
                                threads=ym.getThreads()))
     wall0 = time.time()
     particles = 0
+    stopped = []                        # runs the solver stopped: named with the message, the other runs still run
+
+    def attempt(name, fn, *args):
+        try:
+            return fn(*args)
+        except (ym.MpmSimulationError, RuntimeError) as err:
+            stopped.append(dict(run=name, error=str(err)))
+            print(f"[penny_crack] {name} stopped: {err}", flush=True)
+            return None
+    e = None
     if "elastic" in parts:
-        e = run_elastic(a.size, a.spacing, a.elastic_pressure, a)
+        e = attempt(f"elastic l={a.spacing:g}", run_elastic, a.size, a.spacing, a.elastic_pressure, a)
+    if e is not None:
         particles = max(particles, e["particles"])
         out.write_csv(os.path.join(a.out, "elastic_uy.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
                       zip(e["x"], e["uy"], e["ua"]))
@@ -344,7 +359,10 @@ def main(argv=None):
     if "convergence" in parts:
         conv = []
         for h in [float(v) for v in a.conv_spacings.split(",")]:
-            c = e if ("elastic" in parts and abs(h - a.spacing) < 1e-12) else run_elastic(a.size, h, a.elastic_pressure, a)
+            same = "elastic" in parts and abs(h - a.spacing) < 1e-12
+            c = e if same else attempt(f"convergence l={h:g}", run_elastic, a.size, h, a.elastic_pressure, a)
+            if c is None:
+                continue
             conv.append(c)
             out.write_csv(os.path.join(a.out, f"elastic_uy_l{h:g}.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
                           zip(c["x"], c["uy"], c["ua"]))
@@ -352,15 +370,16 @@ def main(argv=None):
         out.write_csv(os.path.join(a.out, "error_vs_walltime.csv"),
                       ["spacing_m", "particles", "steps", "wall_s", "uy_center_rel_error", "uy_l2_rel_error", "syy_ahead_l2_rel_error"],
                       [(c["h"], c["particles"], c["steps"], c["wall"], c["uy_centre_err"], c["uy_l2"], c["syy_l2_far"]) for c in conv])
-        plot_convergence(conv, a.out)
+        if conv:
+            plot_convergence(conv, a.out)
         summary["convergence"] = [dict(spacing_m=c["h"], particles=c["particles"], wall_time_s=c["wall"],
                                        uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
+    results = []
     if "damage" in parts:
-        results = []
         for law in a.laws.split(","):
-            if law not in CHOICES["growthLaw"]:
-                ap.error(f"--laws: {law!r} is not one of {CHOICES['growthLaw']}")
-            r = run_damage(a, law, a.out)
+            r = attempt(f"damage {law}", run_damage, a, law, a.out)
+            if r is None:
+                continue
             results.append(r)
             particles = max(particles, r["particles"])
             table = [dict(t_s=t, left=interp_da(r["rows"], t)[0], right=interp_da(r["rows"], t)[1])
@@ -373,6 +392,7 @@ def main(argv=None):
                 summary[f"damage_{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
             print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
                   + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
+    if "damage" in parts and results:
         plot_da(results, a.out)
         first = summary[f"damage_{results[0]['law']}"]
         summary["default_law"] = results[0]["law"]
@@ -382,6 +402,7 @@ def main(argv=None):
         if "paper_comparison" in first:
             summary["paper_comparison"] = first["paper_comparison"]
         summary["paper_crack_extension_cells"] = [dict(t_s=t, cells=n) for t, n in PAPER_DA]
+    summary["stopped"] = stopped
     summary["wall_time_s"] = time.time() - wall0
     summary["particles"] = particles
     summary["parts_run"] = sorted(parts)
@@ -401,6 +422,9 @@ def main(argv=None):
             summary = merged
     out.write_summary(a.out, summary)
     batch.write_summary(a.out, [study_row(a, parts, summary)])
+    if stopped:
+        print(f"[penny_crack] stopped: {', '.join(x['run'] for x in stopped)} (summary.json)", flush=True)
+        sys.exit(1)
     return summary
 
 

@@ -86,3 +86,31 @@ def test_damage_grows_symmetrically_and_monotonically(tmp_path):
     # nothing yields (paper: "plasticity never happens"): the rock ahead of the tip reaches the GK threshold
     # long before the DP cone, and a cracked particle (D = 1) keeps no tension that could reach the apex
     assert s["plastic_particles"] == 0
+
+
+def test_a_stopped_run_is_named_and_the_others_still_run(tmp_path, monkeypatch):
+    """A convergence run that the solver stops (run_elastic raises the solver's error at the coarse spacing) is named under
+    "stopped" in summary.json with its message, the other spacing still runs and is reported, exit status 1; a bad
+    --laws entry is refused before any run."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("penny_crack", os.path.join(ROOT, "scripts", "penny_crack.py"))
+    pc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(pc)
+    real = pc.run_elastic
+
+    def run_elastic(size, h, *a, **k):
+        if abs(h - 0.16) < 1e-12:
+            raise ym.MpmSimulationError("MPM stopped at step 3: test failure")
+        return real(size, h, *a, **k)
+    monkeypatch.setattr(pc, "run_elastic", run_elastic)
+    argv = ["--out", str(tmp_path), "--parts", "convergence", "--size", "2.4", "--conv-spacings", "0.16,0.08",
+            "--elastic-max-transits", "2", "--progress", "1000"]
+    with pytest.raises(SystemExit) as e:
+        pc.main(argv)
+    assert e.value.code == 1
+    s = json.load(open(tmp_path / "summary.json"))
+    assert s["stopped"] == [dict(run="convergence l=0.16", error="MPM stopped at step 3: test failure")]
+    assert [c["spacing_m"] for c in s["convergence"]] == [0.08]
+    with pytest.raises(SystemExit) as e:
+        pc.main(["--out", str(tmp_path / "bad"), "--parts", "damage", "--laws", "benz-asphaug,nope"])
+    assert e.value.code == 2 and not (tmp_path / "bad").exists()
