@@ -161,3 +161,21 @@ def test_real_sigint_stops_after_the_outputs(tmp_path):
     files = [d.get("file") for d in ET.parse(tmp_path / "particles.pvd").getroot().iter("DataSet")]
     assert files == [f"particles_{k:08d}.vtu" for k in (10, 20, s.steps)]
     assert all((tmp_path / f).exists() for f in files)
+
+
+def test_solver_error_propagates_or_returns_with_its_message():
+    """The intact body pushed off the grid (the stability suite's grid_edge case) stops the solver: by default the error
+    propagates; with on_error="return" the run returns reason "error" with the solver's message and the steps it took;
+    a bad on_error is named."""
+    from yade_mpm.validation import stability as st
+    s, _ = st.case_grid_edge(True)
+    with pytest.raises(ym.MpmSimulationError):
+        runner.run(s, max_steps=10000)
+    s, _ = st.case_grid_edge(True)
+    r = runner.run(s, max_steps=10000, on_error="return")
+    assert r.reason == "error" and "left the grid" in r.error and 0 < r.steps < 10000 and s.steps == r.steps
+    assert "error=" in repr(r)
+    with pytest.raises(ValueError, match="on_error = 'ignore' must be 'raise' or 'return'"):
+        runner.run(s, max_steps=1, on_error="ignore")
+    s, _ = st.case_grid_edge(True)
+    assert runner.run(s, max_steps=1).error is None

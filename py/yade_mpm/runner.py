@@ -22,8 +22,10 @@ A callback is ``f(solver)``; it may return ``runner.STOP`` to end the run after 
 convergence check that is expensive to evaluate every step). ``stop(solver)`` is evaluated after every
 step. Ctrl-C (KeyboardInterrupt) ends the run cleanly: the ``at_end`` outputs are called with the
 state of the last completed step, then the interrupt is re-raised (default) or the run returns with
-reason "interrupted" (``on_interrupt="return"``). A solver error (``MpmSimulationError``) propagates
-at once, without the ``at_end`` outputs, since the state is then half-updated.
+reason "interrupted" (``on_interrupt="return"``). A solver error (``MpmSimulationError``; through YADE's
+``O.step`` a ``RuntimeError``) ends the run at once, without the ``at_end`` outputs, since the state is then
+half-updated: it propagates (default) or, with ``on_error="return"``, the run returns with reason "error" and the
+message in ``RunResult.error`` (a script that runs several cases records it and goes on to the next).
 """
 import math
 import numbers
@@ -140,14 +142,15 @@ def _reached(t, target):
 
 
 class RunResult:
-    """How a run ended: reason ("end_time", "max_steps", "stop", "interrupted"), steps taken in this
-    run, simulated time at the end [s], wall time [s]."""
+    """How a run ended: reason ("end_time", "max_steps", "stop", "interrupted", "error"), steps taken in this
+    run, simulated time at the end [s], wall time [s], and for "error" the solver's message (else None)."""
 
-    def __init__(self, reason, steps, time, wall):
-        self.reason, self.steps, self.time, self.wall = reason, steps, time, wall
+    def __init__(self, reason, steps, time, wall, error=None):
+        self.reason, self.steps, self.time, self.wall, self.error = reason, steps, time, wall, error
 
     def __repr__(self):
-        return f"RunResult(reason={self.reason!r}, steps={self.steps}, time={self.time:.6g}, wall={self.wall:.3g})"
+        tail = f", error={self.error!r}" if self.error is not None else ""
+        return f"RunResult(reason={self.reason!r}, steps={self.steps}, time={self.time:.6g}, wall={self.wall:.3g}{tail})"
 
 
 def _outputs(every, outputs):
@@ -169,7 +172,7 @@ def _outputs(every, outputs):
 
 
 def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=None, every=(), outputs=(),
-        before_step=None, on_interrupt="raise", advance=None):
+        before_step=None, on_interrupt="raise", advance=None, on_error="raise"):
     """Step `solver` until simulated time ≥ end_time [s] (absolute solver time), or `max_steps` steps of
     this call, or ``stop(solver)`` is true after a step, or an output callback returns STOP.
 
@@ -177,6 +180,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
     every: [(period [s], callback), …] or Output objects; outputs: Output objects (see Output).
     before_step: f(solver) called before each step (e.g. to take ``stableDt()`` of the state before it).
     on_interrupt: "raise" (re-raise KeyboardInterrupt after the at_end outputs) or "return".
+    on_error: "raise" (a solver error propagates) or "return" (RunResult with reason "error" and its message).
     advance: f() that advances the whole simulation by one step (default ``solver.step``); YADE's
     ``O.step`` when the solver runs inside O.engines through an MpmEngine (rigid bodies, DEM).
     Returns a RunResult."""
@@ -190,6 +194,8 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         raise ValueError(f"before_step = {before_step!r} must be callable as f(solver)")
     if on_interrupt not in ("raise", "return"):
         raise ValueError(f"on_interrupt = {on_interrupt!r} must be 'raise' or 'return'")
+    if on_error not in ("raise", "return"):
+        raise ValueError(f"on_error = {on_error!r} must be 'raise' or 'return'")
     if advance is not None and not callable(advance):
         raise ValueError(f"advance = {advance!r} must be callable as f() (one step of the simulation)")
     step = advance if advance is not None else solver.step
@@ -239,6 +245,10 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         if on_interrupt == "raise":
             raise
         return RunResult("interrupted", taken, solver.time, _time.time() - wall0)
+    except RuntimeError as e:                      # MpmSimulationError, or through YADE's O.step a RuntimeError
+        if on_error == "raise":
+            raise
+        return RunResult("error", taken, solver.time, _time.time() - wall0, error=str(e))
     _finish(solver, outs, prog)
     return RunResult(reason, taken, solver.time, _time.time() - wall0)
 
