@@ -241,6 +241,20 @@ struct Grid {
 	template <class F>
 	void forEachMirrorPair(F&& f) const { mirrors.forEachPair(f); }
 	Real mirrorShare(size_t i) const { return mirrors.share(coords(i)); } // weight of node i in body reactions
+	// The node whose content node i mirrors after unfold (partnerOf), with the reflection per axis: v_i = sign ∘ v_j
+	// (sign[a] = −1 where the partner lies across a plane normal to a).
+	size_t mirrorSource(size_t i, int (&sign)[D]) const
+	{
+		const IVec c = coords(i), p = mirrors.empty() ? c : mirrors.partner(c);
+		for (int a = 0; a < D; ++a) sign[a] = p[a] == c[a] ? 1 : -1;
+		return linear(p);
+	}
+	// f(j, sign) for every node j of the modelled region that receives a contribution to node i (MirrorPlanes::receivers).
+	template <class F>
+	void forMirrorReceivers(size_t i, F&& f) const
+	{
+		mirrors.receivers(coords(i), [&](const IVec& c, const int* sign) { f(linear(c), sign); });
+	}
 
 private:
 	static std::string num(Real v)

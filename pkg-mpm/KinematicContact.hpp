@@ -14,8 +14,9 @@
 // body receives −λ_p/Δt at x_p: momentum conserved to round-off; Σ_i ψ_i x_i = x_p: the moment acts at x_p).
 // The particles share nodes, so the impulses are found together by projected Gauss–Seidel over the contacts in
 // a fixed order (deterministic, serial), each update with the effective mass of its direction,
-//   1/k = Σ_a e_a² Σ_i ψ_i²/m_i + e·(W_B e)  (i over the nodes whose component a is free; W_B: the free body's inverse
-//   mass and inertia at r_p, 0 if prescribed),
+//   1/k = Σ_a e_a² Σ_i ψ_i²/m_i + e·(W_B e)  (i over the nodes whose component a is free; with symmetry planes the
+//   read and write weights of the record below, Σ rd_i w_i/m_i; W_B: the free body's inverse mass and inertia at r_p,
+//   0 if prescribed),
 // λ_n clamped ≥ 0 and λ_t to the Coulomb + cohesion disc; a free body's velocity is updated with each impulse
 // (−W_B J_pᵀ Δλ), so it takes its share of every exchange.
 #pragma once

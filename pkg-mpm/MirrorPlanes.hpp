@@ -98,29 +98,13 @@ public:
 		for (const auto& m : list)
 			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * m.stride, col + size_t(kp) * m.stride, m.axis); });
 	}
-	// The node of the modelled region whose reflection node i holds after unfold (i itself when it is not beyond a
-	// plane), sign[a] = −1 for an odd number of reflections along a: v_i = sign ∘ v_j.
-	template <class G>
-	size_t source(const G& g, size_t i, int (&sign)[D]) const
+	// The nodes of the modelled region that receive a particle's contribution to the node at c0 in the mirror-symmetric
+	// full-space problem (what fold does to the nodal sums): f(c, sign) for c0 itself if it is not beyond a plane, and
+	// for every reflection of c0 across planes within 2 cells that lands in the modelled region, sign[a] = −1 for an odd
+	// number of reflections along a (a node on a plane receives its own reflection too).
+	template <class F>
+	void receivers(const IVec& c0, F&& f) const
 	{
-		for (int a = 0; a < D; ++a) sign[a] = 1;
-		IVec c     = g.coords(i);
-		bool moved = false;
-		for (const auto& m : list)
-			if (m.side * (2 * c[m.axis] - m.twoP) > 0) c[m.axis] = m.twoP - c[m.axis], sign[m.axis] = -sign[m.axis], moved = true;
-		if (!moved) return i;
-		size_t j = 0;
-		for (int a = 0; a < D; ++a) j += size_t(c[a]) * g.stride[a];
-		return j;
-	}
-	// The nodes of the modelled region that receive a particle's contribution to node i in the mirror-symmetric
-	// full-space problem (what fold does to the nodal sums): f(j, sign) for node i itself if it is not beyond a plane,
-	// and for every reflection of i across planes within 2 cells that lands in the modelled region, sign[a] = −1 for
-	// an odd number of reflections along a (a node on a plane receives its own reflection too).
-	template <class G, class F>
-	void receivers(const G& g, size_t i, F&& f) const
-	{
-		const IVec   c0 = g.coords(i);
 		const size_t nm = list.size();
 		for (size_t mask = 0; mask < (size_t(1) << nm); ++mask) {
 			IVec c  = c0;
@@ -135,10 +119,7 @@ public:
 				c[m.axis] = m.twoP - c[m.axis], sg[m.axis] = -sg[m.axis];
 			}
 			for (size_t k = 0; k < nm && ok; ++k) ok = list[k].side * (2 * c[list[k].axis] - list[k].twoP) <= 0;
-			if (!ok) continue;
-			size_t j = 0;
-			for (int a = 0; a < D; ++a) j += size_t(c[a]) * g.stride[a];
-			f(j, sg);
+			if (ok) f(c, sg);
 		}
 	}
 	// Share of the node at c in the modelled region: 0 beyond a plane (an image), 1/2 for each plane it

@@ -171,7 +171,7 @@ public:
 				{
 					collectKinematic(grid, P, sched, offs, gi, wk, dt, massFloor, err);
 					solveKinematic(grid, gi);
-					kinematicReactions(grid, gi, dt, 1);
+					kinematicReactions(gi, dt, 1);
 				}
 				MPM_ONE_THREAD_END
 				continue;
@@ -477,10 +477,10 @@ private:
 						continue;
 					}
 					int       sg[D];
-					const int k = entry(grid.mirrors.source(grid, i, sg));
+					const int k = entry(grid.mirrorSource(i, sg));
 					if (k >= 0)
 						for (int a = 0; a < D; ++a) c.rd[k][a] += sg[a] * psi;
-					grid.mirrors.receivers(grid, i, [&](size_t j, const int* sj) {
+					grid.forMirrorReceivers(i, [&](size_t j, const int* sj) {
 						const int kj = entry(j);
 						if (kj >= 0)
 							for (int a = 0; a < D; ++a) c.w[kj][a] += sj[a] * psi;
@@ -511,7 +511,7 @@ private:
 				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] = 0;
 		for (int p : g.parts) dq[p] = Motion {};
 	}
-	// 1/k of an impulse along unit e at contact c: Σ_a e_a² Σ_i ψ_i²/m_i (free components) + e·(W_B e).
+	// 1/k of an impulse along unit e at contact c: Σ_a e_a² kinvAxis[a] (Σ_k rd_k w_k/m_k, free components) + e·(W_B e).
 	Real kinematicCompliance(const KinematicContactRec<D>& c, const RigidPart<D>& q, const Vec& e) const
 	{
 		Real k = 0;
@@ -574,7 +574,7 @@ private:
 	}
 	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_k w_k ∘ λ/Δt, in contact order
 	// (sign −1 takes back what an earlier call reported, before the re-projection after the late damping).
-	void kinematicReactions(const Grid<D>&, size_t gi, Real dt, int sign)
+	void kinematicReactions(size_t gi, Real dt, int sign)
 	{
 		if (gi >= kcs.size()) return;
 		auto& A = nodeArr;
@@ -603,9 +603,9 @@ public:
 	{
 		for (size_t gi = 0; gi < groups.size(); ++gi) {
 			if (groups[gi].params.law != ContactLaw::Kinematic || work[gi].skip) continue;
-			kinematicReactions(grid, gi, dt, -1);
+			kinematicReactions(gi, dt, -1);
 			solveKinematic(grid, gi);
-			kinematicReactions(grid, gi, dt, 1);
+			kinematicReactions(gi, dt, 1);
 		}
 	}
 
