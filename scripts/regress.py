@@ -80,7 +80,9 @@ def run_case(tree, name, out):
     env = dict(os.environ, PYTHONPATH=os.path.join(tree, "py"), OMP_NUM_THREADS="1")
     t0 = time.time()
     extra = ["--courant", f"{COURANT:g}"] if COURANT is not None else []
-    r = subprocess.run([sys.executable, os.path.join(tree, "scripts", script), "--out", d, *argv, *extra], env=env, capture_output=True,
+    path = os.path.join(tree, "scripts", "paper", script)
+    path = path if os.path.exists(path) else os.path.join(tree, "scripts", script)      # trees before scripts/paper
+    r = subprocess.run([sys.executable, path, "--out", d, *argv, *extra], env=env, capture_output=True,
                        text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{name}: {script} failed (exit {r.returncode}):\n{r.stdout[-1500:]}\n{r.stderr[-3000:]}")

@@ -31,3 +31,16 @@ def set_velocity(s, fn):
 def total_momentum(s, d=2):
     m = s.view("mass")
     return np.array([np.sum(m * s.view(f"v{a}")) for a in range(d)])
+
+
+ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+
+
+def script_path(name):
+    """A shipped script by file name, wherever its purpose folder keeps it (scripts/paper, scripts/studies,
+    scripts/tools, scripts/, examples/)."""
+    import glob
+    import os
+    found = sorted(glob.glob(os.path.join(ROOT, "scripts", "**", name), recursive=True) + glob.glob(os.path.join(ROOT, "examples", name)))
+    assert len(found) == 1, f"script {name!r}: {found}"
+    return found[0]

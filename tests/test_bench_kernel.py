@@ -1,4 +1,4 @@
-"""scripts/bench_kernel.py's all-float variant of the ceiling kernel (issue 19's single-precision bound)."""
+"""scripts/tools/bench_kernel.py's all-float variant of the ceiling kernel (issue 19's single-precision bound)."""
 import os
 import re
 import shutil
@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts", "tools"))
 import bench_kernel  # noqa: E402
 
 SNIPPET = """typedef double v4d __attribute__((vector_size(32)));

@@ -1,4 +1,4 @@
-"""yade_mpm.validation.bonded (the JCFpm side of scripts/compare_bonded.py): modulus of a stress–strain curve,
+"""yade_mpm_paper.validation.bonded (the JCFpm side of scripts/paper/compare_bonded.py): modulus of a stress–strain curve,
 discs cut by a hole (against the exact point–polygon distance), Love–Weber stress against a hand
 calculation, and bad micro-parameters refused."""
 import math
@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm.validation import bonded
+from yade_mpm_paper.validation import bonded
 
 yade = pytest.importorskip("yade")
 

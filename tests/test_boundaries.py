@@ -3,6 +3,7 @@ act where they are placed (one-sided WLS), thin gaps do not tie their faces thro
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm_paper import cases
 from helpers import set_velocity
 
 MAT = ym.rocks.GRANITE
@@ -10,7 +11,7 @@ GAP = ym._core.exclusionBits["gap"]
 
 
 def _block_on_plane(dim, axis, side, steps):
-    s = ym.cases.uniform_stress_block(dim, axis, side, cells=6, sigma=-40e6)
+    s = cases.uniform_stress_block(dim, axis, side, cells=6, sigma=-40e6)
     s.run(steps)
     sg = ym.get(s, "stress")
     others = [k for k in range(sg.shape[1]) if k != axis and not (dim == 2 and k == 2)]
@@ -26,8 +27,8 @@ def test_uniform_stress_on_a_slip_plane_is_exact(dim, axis, side):
 
 
 def _fixed_free_period(cells_x):
-    s, T, shape = ym.cases.fixed_free_bar(cells_x)
-    return ym.cases.mode_period(s, shape, 1.3 * T) / T - 1     # two downward zero crossings of the mode
+    s, T, shape = cases.fixed_free_bar(cells_x)
+    return cases.mode_period(s, shape, 1.3 * T) / T - 1     # two downward zero crossings of the mode
 
 
 def test_fixed_free_bar_period_second_order():
@@ -126,7 +127,7 @@ def test_thin_gap_nodes_are_the_crack_midline_only():
     ym.add_region(s3, ym.ElasticMat(**MAT), (0, 0), (1, 1), holes=[ym.Circle((0.52, 0.52), 0.1)])
     assert not np.any(s3.excludedNodes() & GAP)
     s4 = ym.make_solver((0, 0), (0.15, 0.15), 0.003)
-    ym.add_region(s4, ym.ElasticMat(**MAT), (0, 0), (0.15, 0.15), holes=ym.cases.arch_tunnel_holes())
+    ym.add_region(s4, ym.ElasticMat(**MAT), (0, 0), (0.15, 0.15), holes=cases.arch_tunnel_holes())
     assert not np.any(s4.excludedNodes() & GAP)
 
 
@@ -191,11 +192,11 @@ def test_open_flaw_exclusion_only_when_thinner_than_the_stencil(spacing, thin):
     # are apart by themselves). There, nodes excluded inside the flaw left material that enters the gap without
     # a fit: the 0.5 mm open-flaw run stopped at 5.46 ms with "too few active grid nodes" (a fragment at the
     # flaw's upper end). Every point inside the flaw must keep a fit that reproduces linear fields.
-    fl = ym.cases.uniaxial_flaw_geometry()
+    fl = cases.uniaxial_flaw_geometry()
     c = fl["center"]
     s = ym.make_solver(tuple(c - 0.02), tuple(c + 0.02), spacing)
     ym.add_region(s, ym.ElasticMat(**MAT), tuple(c - 0.02), tuple(c + 0.02), holes=[fl["polygon"]])
-    n = ym.cases.exclude_nodes_inside(s, fl["polygon"])
+    n = cases.exclude_nodes_inside(s, fl["polygon"])
     assert (n > 0) == thin and (np.count_nonzero(s.excludedNodes() & GAP) >= n)
     rng = np.random.default_rng(2)
     pts = c + rng.uniform(-0.013, 0.013, size=(6000, 2))

@@ -1,9 +1,9 @@
-"""The run records of yade_mpm.cases.tunnel_results / uniaxial_results on constructed curves whose
+"""The run records of yade_mpm_paper.cases.tunnel_results / uniaxial_results on constructed curves whose
 answers are known (the scripts' end-to-end tests run them on real runs: test_tunnel_script, test_studies)."""
 import numpy as np
 import pytest
 
-from yade_mpm.cases import tunnel_results, uniaxial_results
+from yade_mpm_paper.cases import tunnel_results, uniaxial_results
 
 
 def entry(case, stresses):
@@ -53,7 +53,8 @@ def test_compression_run_keeps_the_curve_when_the_solver_stops_the_run(tmp_path)
     # curve.csv up to the error, result.reason "error" and the message. Here a particle is moved off the grid
     # through a view at step 30, which the solver refuses at the next step.
     import yade_mpm as ym
-    from yade_mpm import cases, runner
+    from yade_mpm import runner
+    from yade_mpm_paper import cases
     s, sc = cases.uniaxial_flaw("intact", 0.005, side_room=0.01)
 
     def spoil(solver):
@@ -71,7 +72,8 @@ def test_compression_run_ends_cleanly_on_sigterm(tmp_path):
     # kill PID of a background loading run: the curve up to the signal is written and the run says "interrupted"
     import os
     import signal
-    from yade_mpm import cases, runner
+    from yade_mpm import runner
+    from yade_mpm_paper import cases
     s, sc = cases.uniaxial_flaw("intact", 0.005, side_room=0.01)
 
     def term(solver):

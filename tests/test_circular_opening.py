@@ -9,11 +9,13 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm import cases, rocks
-from yade_mpm.validation import kirsch
+from yade_mpm import rocks
+from yade_mpm_paper import cases
+from yade_mpm_paper.validation import kirsch
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPT = os.path.join(ROOT, "scripts", "circular_opening.py")
+SCRIPT = script_path("circular_opening.py")
 
 
 def run_script(*argv):

@@ -327,7 +327,7 @@ def test_uniaxial_builder_places_platen_and_filler():
     free body inside the flaw (its centre inside the body, the nodes it covers excluded), the top
     particle row at the detection distance; an unknown variant is refused."""
     from yade import O
-    from yade_mpm import cases
+    from yade_mpm_paper import cases
     s, sc = cases.uniaxial_flaw("filled", 0.002, mu_con=0.4)
     W, H = sc["width"], sc["height"]
     platen, filler = O.bodies[sc["platen"]], O.bodies[sc["filler"]]
@@ -352,12 +352,12 @@ def test_uniaxial_builder_places_platen_and_filler():
 
 
 def test_uniaxial_builder_ramp_and_end_caps():
-    """cases.uniaxial_flaw options of scripts/compare_bonded.py: the platen at rest until advance(), then
+    """cases.uniaxial_flaw options of scripts/paper/compare_bonded.py: the platen at rest until advance(), then
     moving each chunk at speed·min(1, t/ramp_time) of the chunk start (displacement = Σ v_k Δt_k, an
     independent sum over the clock), ε_D⁰ = 0.99 exactly in the capped rows near base and platen and the
     rock's value elsewhere; bad options refused before any work."""
     from yade import O
-    from yade_mpm import cases
+    from yade_mpm_paper import cases
     l, speed, ramp, caps = 0.005, 1.0, 2e-5, 2
     def eps0(solver):                                  # ε_D⁰ by particle id
         return solver.view("eps0")[ym.id_order(solver)].copy()

@@ -130,7 +130,7 @@ def test_platen_corner_at_courant_1(case):
     free-slip side planes) keep a smooth volume: every J = V/V0 within 1e-3 of 1 (measured 0.99988–0.99991 at the
     platen's 28 µm; a corner mode shows as a spread)."""
     from yade import O
-    from yade_mpm import cases
+    from yade_mpm_paper import cases
     s, sc = cases.arch_tunnel("intact", 2e-3) if case == "tunnel" else cases.uniaxial_flaw("open", 2e-3)
     s.courant = 1.0
     o = ym.id_order(s)

@@ -145,7 +145,7 @@ def _column(d0, v=0.05, u_end=3e-4, l=0.01, W=0.02, H=0.1, cut=(8, 12), gap=0.3)
     Returns (platen displacement, platen stress) per step, the rock length L and M."""
     from yade import O, utils
     from yade.wrapper import FrictMat
-    from yade_mpm import cases
+    from yade_mpm_paper import cases
     E, nu, rho = ELASTIC["young"], ELASTIC["poisson"], ELASTIC["density"]
     M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
     dp = l / 2
@@ -225,7 +225,8 @@ def test_free_filler_moves_smoothly_at_its_true_mass():
     from yade import O
     import builtins
     from yade.wrapper import PyRunner
-    from yade_mpm import cases, rocks
+    from yade_mpm import rocks
+    from yade_mpm_paper import cases
     s, sc = cases.uniaxial_flaw("filled", 0.002, mu_con=0.6)
     st, u = O.bodies[sc["filler"]].state, sc["flaw"]["direction"]
     assert st.mass == pytest.approx(rocks.miao2018_sandstone().density * 0.025 * 0.002 * 1.0, rel=1e-12)

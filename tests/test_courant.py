@@ -1,5 +1,5 @@
 """The Courant number C: one declaration (pkg-mpm/SolverSettings.hpp) that the scripts' --courant reads,
-and the measurements of the time-step study (yade_mpm.fidelity_courant) on constructed files with known answers."""
+and the measurements of the time-step study (yade_mpm_paper.fidelity.courant) on constructed files with known answers."""
 import os
 import subprocess
 import sys
@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm import fidelity_courant, output
+from yade_mpm import output
+from yade_mpm_paper.fidelity import courant as fidelity_courant
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -35,10 +37,10 @@ def test_unknown_setting_named():
 def test_scripts_read_the_solver_default(script):
     """--help shows the solver's C (not a second declaration); a value out of range is refused before any work."""
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"))
-    h = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", script), "--help"], capture_output=True, text=True, env=env)
+    h = subprocess.run([sys.executable, script_path(script), "--help"], capture_output=True, text=True, env=env)
     assert h.returncode == 0, h.stderr
     assert f"(default: the solver's, {ym.setting_default('courant'):g})" in " ".join(h.stdout.split())
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", script), "--out", "/nonexistent/x", "--courant", "1.5"],
+    r = subprocess.run([sys.executable, script_path(script), "--out", "/nonexistent/x", "--courant", "1.5"],
                        capture_output=True, text=True, env=env)
     assert r.returncode != 0 and "--courant = 1.5" in r.stderr + r.stdout
     assert not os.path.exists("/nonexistent/x")

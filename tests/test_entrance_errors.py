@@ -10,7 +10,9 @@ import sys
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm import cases, checkpoint, resumable
+from yade_mpm import checkpoint
+from yade_mpm_paper import cases
+from yade_mpm.checkpoint import resumable
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROCK = dict(young=1e9, poisson=0.2, density=2500)

@@ -1,11 +1,13 @@
-"""The measurements behind the fidelity table (yade_mpm.fidelity, fidelity_table, analysis.flaw_end_cracks,
+"""The measurements behind the fidelity table (yade_mpm_paper.fidelity, fidelity_table, analysis.flaw_end_cracks,
 cases.tunnel_fidelity) on constructed fields with known answers."""
 import math
 
 import numpy as np
 import pytest
 
-from yade_mpm import analysis, cases, fidelity, fidelity_table, rocks
+from yade_mpm import analysis, rocks
+from yade_mpm_paper import cases, fidelity
+from yade_mpm_paper.fidelity import table as fidelity_table
 
 from test_analysis import DP
 from test_analysis import lattice as _lattice
@@ -170,7 +172,7 @@ def test_von_mises_variant_is_the_named_option_and_the_default_is_the_reference_
 
 def test_every_tunnel_variant_builds_a_valid_flaw_at_the_default_grid():
     # the scene refuses a flaw within one cell of a face or the opening (arch_tunnel's range check): a variant must pass it
-    from yade_mpm.cases.tunnel import _flaw_clear
+    from yade_mpm_paper.cases.tunnel import _flaw_clear
     for name, v in fidelity.VARIANTS.items():
         if v.get("scene") == "tunnel" and "flaw_angle" in v:
             assert _flaw_clear(math.radians(v["flaw_angle"]), 0.002), name

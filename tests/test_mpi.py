@@ -4,7 +4,7 @@
 added in another order: last-bit differences only), for a 2D and a 3D elastic block whose initial
 velocity carries particles across the slab boundary (they migrate between ranks). The 2-rank run twice
 gives the same bits. Skipped when mpirun or the MPI core is missing; every run is bounded by a timeout.
-Open MPI refuses root unless OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM)=1, which scripts/mpi_run.sh sets."""
+Open MPI refuses root unless OMPI_ALLOW_RUN_AS_ROOT(_CONFIRM)=1, which scripts/tools/mpi_run.sh sets."""
 import glob
 import os
 import shutil
@@ -13,9 +13,10 @@ import sys
 
 import numpy as np
 import pytest
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LAUNCH = os.path.join(ROOT, "scripts", "mpi_run.sh")
+LAUNCH = script_path("mpi_run.sh")
 
 CHILD = r"""
 import sys
@@ -243,7 +244,7 @@ def test_rank_without_particles(tmp_path):
 
 def run_child(tmp_path, child, name, tag, steps, ranks, timeout):
     """Write the child script `child` as tmp_path/name and run it with (steps, out) on 1 process or `ranks` MPI ranks
-    (scripts/mpi_run.sh, 1 thread each); subprocess timeout [s] (a hang fails here). Returns each rank's OUT.rank.npz."""
+    (scripts/tools/mpi_run.sh, 1 thread each); subprocess timeout [s] (a hang fails here). Returns each rank's OUT.rank.npz."""
     script = tmp_path / name
     script.write_text(child)
     out = str(tmp_path / tag)

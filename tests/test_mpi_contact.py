@@ -19,9 +19,9 @@ import math, sys
 import numpy as np
 import yade_mpm as ym
 from yade import O, utils
-from yade_mpm import cases
+from yade_mpm_paper import cases
 from yade_mpm.bodies import RigidBodies
-from yade_mpm.cases.loading import yade_engines, yade_filler, yade_platen
+from yade_mpm_paper.cases.loading import yade_engines, yade_filler, yade_platen
 steps, out = int(sys.argv[1]), sys.argv[2]
 l, W, H = 0.01, 0.2, 0.32                      # 36 cells along y with the margins: 2 ranks split at y = 0.14
 slot = cases.tunnel.tunnel_flaw(toe=(0.1, 0.06), length=0.2, width=0.02, angle=math.pi / 2)   # x 0.09–0.11, y 0.06–0.26

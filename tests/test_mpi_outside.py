@@ -13,7 +13,7 @@ CHILD = r"""
 import sys
 import numpy as np
 import yade_mpm as ym
-from yade_mpm.validation import stability as st
+from yade_mpm_paper.validation import stability as st
 damage, steps, out = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 s, block, frag = st.debris_scene(50.0)
 s.view("damage")[np.isin(s.view("id"), frag)] = damage

@@ -1,5 +1,5 @@
 """Dynamic load balance under MPI (pkg-mpm/Decomposition.hpp `rebalance`, doc/scaling.md): a 2D elastic
-block (`yade_mpm.cases.drifting_block`) drifting at 35 m/s along the slab axis through a tall empty grid (about 20 cells in 100 steps) moves
+block (`yade_mpm_paper.cases.drifting_block`) drifting at 35 m/s along the slab axis through a tall empty grid (about 20 cells in 100 steps) moves
 its particles out of the start slabs. With the default `mpiRebalance = 1.1` the slabs are cut again from the
 particle counts per block layer; with `inf` they are not and one rank ends up holding every particle
 (max/mean = 2 on 2 ranks). Either way the particle fields equal one process's within 1e-12 (shared-node sums
@@ -20,8 +20,9 @@ CHILD = r"""
 import sys
 import numpy as np
 import yade_mpm as ym
+from yade_mpm_paper import cases
 threshold, steps, out = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-s = ym.cases.drifting_block(0.01, rebalance=threshold)   # 68 cells along y: 9 block layers
+s = cases.drifting_block(0.01, rebalance=threshold)   # 68 cells along y: 9 block layers
 s.run(steps)
 res = {n: np.array(s.view(n)) for n in ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol", "id"]}
 info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "firstLayers": [], "rebalances": 0, "imbalance": 1.0}

@@ -22,7 +22,7 @@ import math, sys
 import numpy as np
 import yade_mpm as ym
 from yade import O, utils, ForceResetter, NewtonIntegrator
-from yade_mpm import cases
+from yade_mpm_paper import cases
 steps, out = int(sys.argv[1]), sys.argv[2]
 l, W, H = 0.01, 0.2, 0.32
 slot = cases.tunnel.tunnel_flaw(toe=(0.1, 0.06), length=0.2, width=0.04, angle=math.pi / 2)   # x 0.08–0.12, y 0.06–0.26

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm.validation import stability as st
+from yade_mpm_paper.validation import stability as st
 
 END = st.debris_end_time()
 

@@ -1,6 +1,6 @@
 """Pressurised line crack (paper Sec. 3.2) on reduced set-ups that run in seconds: the elastic opening
 against Sneddon (Eq. 43) and the stress ahead of the tip against Eq. 44; crack growth from both tips
-with the DP–GK rock. The full-size numbers come from scripts/penny_crack.py (doc/penny_crack.md)."""
+with the DP–GK rock. The full-size numbers come from scripts/paper/penny_crack.py (doc/penny_crack.md)."""
 import json
 import math
 import os
@@ -11,16 +11,18 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm.validation import sneddon
+from yade_mpm_paper import cases
+from yade_mpm_paper.validation import sneddon
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def run_script(argv):
-    """scripts/penny_crack.py through its command line (one thread, this checkout's package);
+    """scripts/paper/penny_crack.py through its command line (one thread, this checkout's package);
     returns its summary.json."""
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"), OMP_NUM_THREADS="1")
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "penny_crack.py"), *argv], env=env,
+    r = subprocess.run([sys.executable, script_path("penny_crack.py"), *argv], env=env,
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     out = argv[argv.index("--out") + 1]
@@ -38,7 +40,7 @@ def one_thread():
 
 
 def test_sneddon_formulas():
-    E, nu, P, c = ym.rocks.GRANITE["young"], ym.rocks.GRANITE["poisson"], 15e6, ym.cases.CRACK_HALF_LENGTH
+    E, nu, P, c = ym.rocks.GRANITE["young"], ym.rocks.GRANITE["poisson"], 15e6, cases.CRACK_HALF_LENGTH
     # Eq. 43 with a = c is the ellipse 2P(1 − ν²)/E √(c² − x²); zero at and beyond the tips
     assert sneddon.opening_displacement(0.0, P, E, nu, c) == pytest.approx(2 * P * (1 - nu ** 2) / E * c, rel=1e-14)
     assert sneddon.opening_displacement(0.2, P, E, nu, c) == 0.0
@@ -93,7 +95,7 @@ def test_a_stopped_run_is_named_and_the_others_still_run(tmp_path, monkeypatch):
     "stopped" in summary.json with its message, the other spacing still runs and is reported, exit status 1; a bad
     --laws entry is refused before any run."""
     import importlib.util
-    spec = importlib.util.spec_from_file_location("penny_crack", os.path.join(ROOT, "scripts", "penny_crack.py"))
+    spec = importlib.util.spec_from_file_location("penny_crack", script_path("penny_crack.py"))
     pc = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(pc)
     real = pc.run_elastic

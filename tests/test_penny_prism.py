@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm.cases import prism3d
+from yade_mpm_paper.cases import prism3d
 
 pytest.importorskip("yade")
 pytest.importorskip("yade_mpm.bodies")

@@ -1,14 +1,15 @@
 """The particle velocity update of Eq. 6 (v_p = Σ ψ_i v_i) loses a fixed share of a standing elastic wave's energy per
-step, not per unit time (scripts/pic_dissipation.py, doc/algorithm.md "The particle velocity update and C"): over the
+step, not per unit time (scripts/paper/pic_dissipation.py, doc/algorithm.md "The particle velocity update and C"): over the
 same 100 µs, C = 0.5 takes twice the steps of C = 1 and keeps the square of its share (measured 0.9568 and 0.9161,
 0.9568² = 0.9155). A change of the transfer that alters this shows here."""
 import importlib.util
 import os
 
 import pytest
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-spec = importlib.util.spec_from_file_location("pic_dissipation", os.path.join(ROOT, "scripts", "pic_dissipation.py"))
+spec = importlib.util.spec_from_file_location("pic_dissipation", script_path("pic_dissipation.py"))
 pic = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(pic)
 

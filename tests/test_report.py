@@ -1,9 +1,10 @@
-"""scripts/report.py names folders relative to the repository: the generated doc/validation.md holds no
+"""scripts/paper/report.py names folders relative to the repository: the generated doc/validation.md holds no
 absolute path of the machine it was made on (also for output folders elsewhere)."""
 import os
 import re
 import subprocess
 import sys
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ABSOLUTE = re.compile(r"(?<![\w.])/(?:work|home|tmp|root|mnt|srv|opt|var)/")   # /usr/bin/python3 in commands is fine
@@ -13,7 +14,7 @@ def test_generated_report_names_no_absolute_path(tmp_path):
     out = tmp_path / "elsewhere" / "out"
     out.mkdir(parents=True)
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"))
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "report.py"), "--root", str(out), "--doc", str(tmp_path / "doc"),
+    r = subprocess.run([sys.executable, script_path("report.py"), "--root", str(out), "--doc", str(tmp_path / "doc"),
                         "--dir", f"penny_crack_damage={tmp_path / 'crack_runs' / 'c02'}"], capture_output=True, text=True, env=env, timeout=120)
     assert r.returncode == 0, r.stderr[-2000:]
     text = (tmp_path / "doc" / "validation.md").read_text()
@@ -47,14 +48,14 @@ def test_baseline_from_a_tunnel_run_and_the_variant_matrix(tmp_path):
     np.savetxt(case / "axial_stress.csv", np.column_stack([d / 100, d, 100 * d]), delimiter=",", header="time_s,displacement_mm,axial_stress_MPa")
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"))
     run = lambda *args: subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env, timeout=120, cwd=tmp_path)
-    r = run(os.path.join(ROOT, "scripts", "fidelity_variants.py"), "--scene", "tunnel", "--baseline-from", "runs/tunnel/filled_flaw",
+    r = run(script_path("fidelity_variants.py"), "--scene", "tunnel", "--baseline-from", "runs/tunnel/filled_flaw",
             "--out", "out/fidelity_variants")
     assert r.returncode == 0, r.stderr[-2000:]
     j = json.load(open(tmp_path / "out" / "fidelity_variants" / "tunnel_filled_flaw_baseline.json"))
     assert j["stress_MPa_at_mm"]["0.5"] == 50.0 and j["stress_MPa_at_mm"]["2"] == 200.0
     assert j["snapshots"]["20ms"]["eps_p_max"] == 0.04 and j["snapshots"]["8ms"]["eps_p_max"] == 0.01
     assert j["snapshots"]["20ms"]["eps_p_soft_end"] == 0.9 * 0.1 and j["first_crack"] == dict(time_s=2.1e-4, at="flaw toe")
-    r = run(os.path.join(ROOT, "scripts", "report.py"), "--root", "out", "--doc", "doc")
+    r = run(script_path("report.py"), "--root", "out", "--doc", "doc")
     assert r.returncode == 0, r.stderr[-2000:]
     text = (tmp_path / "doc" / "validation.md").read_text()
     row = next(line for line in text.splitlines() if line.startswith("| baseline"))

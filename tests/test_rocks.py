@@ -1,5 +1,5 @@
 """Named rock sets (yade_mpm.rocks) are the only place their numbers are written, and the scene
-builders (yade_mpm.cases) build what the paper describes."""
+builders (yade_mpm_paper.cases) build what the paper describes."""
 import math
 import os
 import re
@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm import cases, rocks
+from yade_mpm import rocks
+from yade_mpm_paper import cases
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

@@ -167,7 +167,7 @@ def test_solver_error_propagates_or_returns_with_its_message():
     """The intact body pushed off the grid (the stability suite's grid_edge case) stops the solver: by default the error
     propagates; with on_error="return" the run returns reason "error" with the solver's message and the steps it took;
     a bad on_error is named."""
-    from yade_mpm.validation import stability as st
+    from yade_mpm_paper.validation import stability as st
     s, _ = st.case_grid_edge(True)
     with pytest.raises(ym.MpmSimulationError):
         runner.run(s, max_steps=10000)

@@ -10,14 +10,15 @@ import subprocess
 import sys
 
 import pytest
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = os.path.join(ROOT, "scripts")
+
 
 
 def run(script, *args, env=None, timeout=300):
     e = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"), **(env or {}))
-    r = subprocess.run([sys.executable, os.path.join(SCRIPTS, script), *map(str, args)], env=e, capture_output=True,
+    r = subprocess.run([sys.executable, script_path(script), *map(str, args)], env=e, capture_output=True,
                        text=True, timeout=timeout)
     return r
 
@@ -123,7 +124,7 @@ def test_circular_opening_names_a_stopped_run_and_goes_on(tmp_path, monkeypatch)
     if the main run stops, summary.json still says why."""
     import importlib.util
     import yade_mpm as ym
-    spec = importlib.util.spec_from_file_location("circular_opening", os.path.join(SCRIPTS, "circular_opening.py"))
+    spec = importlib.util.spec_from_file_location("circular_opening", script_path("circular_opening.py"))
     co = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(co)
     real = co.run_case

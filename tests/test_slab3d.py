@@ -6,8 +6,9 @@ strain exactly); with the default d0 (half the current particle edge, ½V^(1/D),
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm import cases, rocks
-from yade_mpm.cases import slab_compare
+from yade_mpm import rocks
+from yade_mpm_paper import cases
+from yade_mpm_paper.cases import slab_compare
 
 pytest.importorskip("yade")
 pytest.importorskip("yade_mpm.bodies")

@@ -1,4 +1,4 @@
-"""Stability suite (yade_mpm.validation.stability), fast versions (coarse grids) of scripts/stability.py: every case finishes, or is
+"""Stability suite (yade_mpm_paper.validation.stability), fast versions (coarse grids) of scripts/paper/stability.py: every case finishes, or is
 stopped by the solver with a message naming step, particle id and quantity; no NaN; KE + U_el never
 above the input energy by more than the tolerance; Δt never above the stable limit."""
 import math
@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm.validation import stability as st
+from yade_mpm_paper.validation import stability as st
+from helpers import script_path
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -150,7 +151,7 @@ def test_case_stopped_by_an_error_when_expected_to_finish_is_failed(tmp_path):
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
     def script(name):
-        spec = importlib.util.spec_from_file_location(name, os.path.join(root, "scripts", f"{name}.py"))
+        spec = importlib.util.spec_from_file_location(name, script_path(f"{name}.py"))
         m = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(m)
         return m

@@ -1,10 +1,10 @@
-"""Studies (issue 21): a table line is a run (yade_mpm.batch), under yade-batch and under scripts/sweep.py.
+"""Studies (issue 21): a table line is a run (yade_mpm_paper.batch), under yade-batch and under scripts/studies/sweep.py.
 
-- yade-batch runs a coarse 2-line variant of scripts/tunnel_spalling.table plus a line with a flaw angle
+- yade-batch runs a coarse 2-line variant of scripts/paper/tunnel_spalling.table plus a line with a flaw angle
   outside the specimen: each good line's summary.csv is byte-identical to a direct run with the same
   options (1 thread under yade-batch, 2 in the direct run); the bad line fails alone and the merged
-  report (scripts/study_report.py) carries its message.
-- scripts/sweep.py on a LocalCluster with 2 workers runs a 4-line table (scripts/circular_opening.py,
+  report (scripts/studies/study_report.py) carries its message.
+- scripts/studies/sweep.py on a LocalCluster with 2 workers runs a 4-line table (scripts/paper/circular_opening.py,
   coarse); one worker is killed (SIGKILL) while it runs a line: the lines finished before stay untouched,
   the killed line is reported failed and its run process dies with its worker; a rerun runs only that line.
 - A table line reads as the same options as a command line; a misspelt column or an unquoted string is
@@ -17,9 +17,10 @@ import signal
 import subprocess
 import sys
 import time
+from helpers import script_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = os.path.join(ROOT, "scripts")
+SCRIPTS = os.path.join(ROOT, "scripts", "studies")
 ENV = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"), OMP_NUM_THREADS="2")
 TUNNEL_COARSE = dict(spacing="0.0025", end_time="0.0001", checkpoint_every="'0'", vtu_every="0.001", pictures="False")
 BAD_ANGLE = 30          # the 60 mm flaw's tip would leave the specimen (allowed ≈ [46, 128]° at 2.5 mm)
@@ -51,11 +52,11 @@ def test_yade_batch_lines_equal_direct_runs_and_a_bad_line_fails_alone(tmp_path,
     table = tmp_path / "tunnel.table"
     write_table(table, cols, rows)
     batch = subprocess.Popen(["yade-batch", "-j", "2", "--job-threads", "1", "--log", str(tmp_path / "@.log"), "--plot-update", "0",
-                              str(table), os.path.join(SCRIPTS, "tunnel_spalling.py")], cwd=tmp_path, env=ENV,
+                              str(table), script_path("tunnel_spalling.py")], cwd=tmp_path, env=ENV,
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     direct = {}
     for d, (c, a, m, e) in good.items():        # the same options on the command line, 2 threads, meanwhile
-        direct[d] = subprocess.Popen([sys.executable, os.path.join(SCRIPTS, "tunnel_spalling.py"), "--out", str(tmp_path / "direct" / d),
+        direct[d] = subprocess.Popen([sys.executable, script_path("tunnel_spalling.py"), "--out", str(tmp_path / "direct" / d),
                                       "--cases", c, "--flaw-angle", a, "--filler-mu", m, "--grout-young", e, "--spacing", "0.0025",
                                       "--end-time", "0.0001", "--checkpoint-every", "0", "--vtu-every", "0.001", "--no-pictures"],
                                      cwd=tmp_path, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -113,7 +114,7 @@ def started(pid):
 
 
 def sweep(tmp_path, table, log, *options):
-    return subprocess.Popen([sys.executable, os.path.join(SCRIPTS, "sweep.py"), str(table), os.path.join(SCRIPTS, "circular_opening.py"),
+    return subprocess.Popen([sys.executable, script_path("sweep.py"), str(table), script_path("circular_opening.py"),
                              "--progress", "2", *options], cwd=tmp_path, env=ENV, stdout=open(log, "w"),
                             stderr=subprocess.STDOUT, start_new_session=True)
 
@@ -181,7 +182,7 @@ def test_sweep_killed_worker_loses_no_finished_line_and_a_rerun_completes_only_t
 def test_table_line_becomes_the_command_line_and_bad_columns_are_named(tmp_path, monkeypatch):
     import argparse
     sys.path.insert(0, os.path.join(ROOT, "py"))
-    from yade_mpm import batch
+    from yade_mpm_paper import batch
     ap = argparse.ArgumentParser(prog="demo.py")
     ap.add_argument("--out", default="x")
     ap.add_argument("--spacing", type=float, default=0.002)
@@ -214,10 +215,10 @@ def test_table_line_becomes_the_command_line_and_bad_columns_are_named(tmp_path,
 def test_shipped_tables_name_only_options_of_their_scripts():
     import re
     sys.path.insert(0, os.path.join(ROOT, "py"))
-    from yade_mpm import batch
+    from yade_mpm_paper import batch
     for name in ("tunnel_spalling", "uniaxial_flaw", "penny_crack", "circular_opening"):
-        table = os.path.join(SCRIPTS, name + ".table")
-        help_text = subprocess.run([sys.executable, os.path.join(SCRIPTS, name + ".py"), "--help"], env=ENV, capture_output=True,
+        table = script_path(name + ".table")
+        help_text = subprocess.run([sys.executable, script_path(name + ".py"), "--help"], env=ENV, capture_output=True,
                                    text=True, timeout=60).stdout
         options = set(re.findall(r"--([a-z][a-z0-9-]*)", help_text))
         runs = batch.lines(table)

@@ -1,4 +1,4 @@
-"""The arch-tunnel scene of paper Sec. 4 (yade_mpm.cases.arch_tunnel) on a coarse grid: the flaw cut,
+"""The arch-tunnel scene of paper Sec. 4 (yade_mpm_paper.cases.arch_tunnel) on a coarse grid: the flaw cut,
 the rigid filler fitting it without touching a particle, the grout filling it; the platen's first
 stress is the 1D impact stress ρ c_p v (plane strain, slip walls) until the wave returns from the
 opening; the intact scene stays mirror symmetric; a filled-flaw run resumes bitwise from a checkpoint."""
@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm import analysis, cases, checkpoint, rocks
+from yade_mpm import analysis, checkpoint, rocks
+from yade_mpm_paper import cases
 
 yade = pytest.importorskip("yade")
 pytest.importorskip("yade_mpm.bodies")   # rigid-body contact (platen, filler)

@@ -1,4 +1,4 @@
-"""scripts/tunnel_spalling.py end to end on the coarsest grid and a few hundredths of a millisecond:
+"""scripts/paper/tunnel_spalling.py end to end on the coarsest grid and a few hundredths of a millisecond:
 the output files and summary.json keys the issue names; a run stopped half-way and continued with
 --resume ends in exactly the state of the run made in one go (particles and platen, from the
 checkpoints)."""
@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 import pytest
+from helpers import script_path
 
 pytest.importorskip("yade")
 pytest.importorskip("yade_mpm.bodies")   # rigid-body contact (platen, filler)
@@ -19,7 +20,7 @@ KEYS = {"case", "grid_spacing_m", "particles", "steps", "wall_time_s", "particle
 
 def run(out, *args):
     env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "tunnel_spalling.py"), "--out", str(out), "--spacing", "0.0025",
+    r = subprocess.run([sys.executable, script_path("tunnel_spalling.py"), "--out", str(out), "--spacing", "0.0025",
                         "--checkpoint-every", "0", "--vtu-every", "1e-5", *args], capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
     return r.stdout

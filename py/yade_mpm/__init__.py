@@ -7,7 +7,7 @@ import os as _os
 
 # Threads that wait at a barrier spin only briefly (~10 µs) and then sleep: spinning long steals the
 # core a descheduled partner needs on a loaded 2-core host, sleeping at once slows the ~12 barriers
-# of a step on an idle one (both measured with scripts/bench.py). Results do not depend on it.
+# of a step on an idle one (both measured with scripts/tools/bench.py). Results do not depend on it.
 # Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE); users may override.
 _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
@@ -30,7 +30,7 @@ from ._core import ContactParams
 from .bodies import RigidBodies, contact_params
 from .spheres import DemSpheres
 from .progress import Progress
-from . import rocks, cases, runner, output  # noqa: E402  (rock sets, scene builders, run loop, result files)
+from . import rocks, runner, output  # noqa: E402  (rock sets, run loop, result files)
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",

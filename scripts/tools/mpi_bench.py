@@ -1,0 +1,47 @@
+"""Per-step wall time of the benchmark block (scripts/tools/bench.py's build_scene: granite on a fixed floor,
+slip side walls, initial pure-shear velocity) on 1 process or N MPI ranks (doc/scaling.md):
+
+    /usr/bin/python3 scripts/tools/mpi_bench.py --cells 50 50 25            # serial core
+    scripts/tools/mpi_run.sh 2 1 scripts/tools/mpi_bench.py --cells 50 50 25      # 2 ranks × 1 thread
+
+Every rank prints one JSON line (rank, particles, seconds per step, phase times per step); the ranks
+step in lock-step (two shared-node exchanges and one reduction per step), so rank 0's time is the
+step time. Timings on a loaded host are labelled as such in doc/scaling.md."""
+import argparse
+import json
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cells", type=int, nargs="+", default=[50, 50, 25], help="block size in cells (2 or 3 numbers)")
+    ap.add_argument("--material", choices=["elastic", "dpgk"], default="elastic")
+    ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--warmup", type=int, default=3)
+    a = ap.parse_args()
+    if len(a.cells) not in (2, 3) or min(a.cells) < 1:
+        ap.error(f"--cells = {a.cells} must be 2 or 3 integers ≥ 1")
+    if a.steps < 1 or a.warmup < 0:
+        ap.error("--steps must be ≥ 1 and --warmup ≥ 0")
+    from bench import build_scene
+    import yade_mpm as ym
+    s = build_scene(len(a.cells), a.material, tuple(a.cells))
+    n_total = s.numParticles
+    s.run(a.warmup)
+    p0 = dict(s.phaseTimes())
+    t0 = time.perf_counter()
+    s.run(a.steps)
+    dt = (time.perf_counter() - t0) / a.steps
+    ph = {k: (v - p0.get(k, 0.0)) / a.steps for k, v in dict(s.phaseTimes()).items()}
+    info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "firstLayers": [], "haloBytesSent": 0}
+    print(json.dumps(dict(rank=info["rank"], ranks=info["size"], threads=ym.getThreads(), particles_total=n_total,
+                          particles=s.numParticles, seconds_per_step=dt, phase_seconds_per_step=ph,
+                          first_layers=list(info["firstLayers"]), halo_bytes_sent=info["haloBytesSent"])), flush=True)
+
+
+if __name__ == "__main__":
+    main()
