@@ -160,7 +160,7 @@ def main(argv=None):
         rec()
         sphere_frames.append((O.time, os.path.join(a.out, f"spheres-spheres.{O.iter}.vtu")))
         out.write_pvd(os.path.join(a.out, "spheres.pvd"), sphere_frames)
-    prog = ym.Progress(a.end_time, "rockfall", a.progress)
+    prog = ym.progress.Progress(a.end_time, "rockfall", a.progress)
     t_next, dem_contacts = 0.0, 0
     t0 = time.time()
     while O.time < a.end_time:

@@ -122,7 +122,7 @@ def _dpgk():
 def _upd(**kw):
     a = dict(material=_dpgk(), stress=[0.0] * 4, strainInc=[1e-4, 0, 0, 0], epsP=0.0, damage=0.0, eps0=1e-4, dt=1e-6)
     a.update(kw)
-    return ym.dpgkPointUpdate2D(*a.values())
+    return ym.materials.dpgkPointUpdate2D(*a.values())
 
 
 @pytest.mark.parametrize("call, msg", [
@@ -181,9 +181,9 @@ def test_too_many_threads_refused_not_crashing():
     (lambda: ym.Box((0, np.nan), (1, 1)), r"Box lo = \(0.0, nan\) m must be finite"),
     (lambda: ym.Polygon([(0, 0), (1, 0), (np.inf, 1)]), r"Polygon vertices must be finite"),
     (lambda: ym.Polygon([(0, 0), (1, 1), (2, 2)]), r"zero area"),
-    (lambda: ym.rotated_rectangle((np.nan, 0.5), 0.4, 0.1, 0.3), r"rotated_rectangle center = \(nan, 0.5\) m must be finite"),
-    (lambda: ym.rotated_rectangle((0.5, 0.5), 0.4, 0.1, np.inf), r"rotated_rectangle angle = inf rad"),
-    (lambda: ym.rotated_rectangle((0.5, 0.5), -0.4, 0.1, 0.0), r"rotated_rectangle length = -0.4 m is outside the allowed range \(0, inf\)"),
+    (lambda: ym.geometry.rotated_rectangle((np.nan, 0.5), 0.4, 0.1, 0.3), r"rotated_rectangle center = \(nan, 0.5\) m must be finite"),
+    (lambda: ym.geometry.rotated_rectangle((0.5, 0.5), 0.4, 0.1, np.inf), r"rotated_rectangle angle = inf rad"),
+    (lambda: ym.geometry.rotated_rectangle((0.5, 0.5), -0.4, 0.1, 0.0), r"rotated_rectangle length = -0.4 m is outside the allowed range \(0, inf\)"),
 ])
 def test_hole_with_nonfinite_geometry_refused(make, msg):
     """A NaN/inf centre, vertex or angle made a hole that silently removed nothing."""
@@ -194,15 +194,15 @@ def test_hole_with_nonfinite_geometry_refused(make, msg):
 def test_hole_dimension_must_match_region():
     """A 2D Circle in a 3D region was a NumPy broadcast error; now it names the hole."""
     with pytest.raises(ValueError, match=r"holes\[0\] is a 2D Circle but the region is 3D"):
-        ym.fill_region((0, 0, 0), (1, 1, 1), 0.25, holes=[ym.Circle((0.5, 0.5), 0.2)])
+        ym.geometry.fill_region((0, 0, 0), (1, 1, 1), 0.25, holes=[ym.Circle((0.5, 0.5), 0.2)])
     with pytest.raises(ValueError, match=r"holes\[1\] is a 3D Box but the region is 2D"):
-        ym.fill_region((0, 0), (1, 1), 0.1, holes=[ym.Circle((0.5, 0.5), 0.2), ym.Box((0, 0, 0), (1, 1, 1))])
+        ym.geometry.fill_region((0, 0), (1, 1), 0.1, holes=[ym.Circle((0.5, 0.5), 0.2), ym.Box((0, 0, 0), (1, 1, 1))])
     s3 = ym.make_solver((0, 0, 0), (1, 1, 1), 0.25)
     with pytest.raises(ValueError, match=r"region lo = \(0, 0\) must have 3 components for a 3D solver"):
         ym.add_region(s3, ym.rocks.granite(), (0, 0), (1, 1))
     # a polygon is a prism along z in 3D: allowed, and it removes the prism (volume check)
     sq = ym.Polygon([(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)])
-    x, v = ym.fill_region((0, 0, 0), (1, 1, 1), 0.125, ppc=1, holes=[sq])
+    x, v = ym.geometry.fill_region((0, 0, 0), (1, 1, 1), 0.125, ppc=1, holes=[sq])
     assert len(x) * v == pytest.approx(1 - 0.5 * 0.5 * 1)
 
 
@@ -229,12 +229,12 @@ def test_face_traction_on_a_face_without_particles_refused():
 @pytest.mark.parametrize("call, msg", [
     (lambda: ym.make_solver((0, 0), (1, np.nan), 0.1), r"make_solver hi = \(1.0, nan\) m must be finite"),
     (lambda: ym.make_solver((0, 0), (1, 1), "a"), r"spacing must be a number \[m\]"),
-    (lambda: ym.fill_region((0, 0), (1, np.inf), 0.1), r"region hi = \(1.0, inf\) m must be finite"),
-    (lambda: ym.fill_region((0, 0), (1, 1), 0.1, keep=lambda x: np.ones(3, bool)), r"keep returned shape \(3,\)"),
+    (lambda: ym.geometry.fill_region((0, 0), (1, np.inf), 0.1), r"region hi = \(1.0, inf\) m must be finite"),
+    (lambda: ym.geometry.fill_region((0, 0), (1, 1), 0.1, keep=lambda x: np.ones(3, bool)), r"keep returned shape \(3,\)"),
     (lambda: ym.boundary_particles(_solver(), 0, 1), r"the solver has no particles"),
     (lambda: ym.boundary_particles(_solver(), 5, 1), r"axis = 5 must be an integer in \[0, 1\]"),
     (lambda: ym.set_initial_stress(_solver(), "abcd"), r"initial stress must be 4 numbers"),
-    (lambda: ym.consistent_row_weights(10 ** 6), r"ppc .* = 1000000 must be an integer in \[2, 16\]"),
+    (lambda: ym.scene.consistent_row_weights(10 ** 6), r"ppc .* = 1000000 must be an integer in \[2, 16\]"),
     (lambda: ym.add_region(None, ym.rocks.granite(), (0, 0), (1, 1)), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
 ])
 def test_scene_helpers_name_the_parameter(call, msg):
@@ -313,9 +313,9 @@ def test_set_particle_forces_is_all_or_nothing():
     (lambda: ym.make_solver((0, 0), (1, 1), True), r"spacing must be a number \[m\] \(got bool True\)"),
     (lambda: ym.get(None, "pos"), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
     (lambda: ym.MpmEngine(None), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
-    (lambda: ym.Progress(np.nan), r"Progress end_time = nan s is outside"),
-    (lambda: ym.Progress(-1.0), r"Progress end_time = -1.0 s is outside the allowed range \[0, inf\)"),
-    (lambda: ym.Progress(1.0, interval=-1), r"Progress interval = -1 s is outside the allowed range \[0, inf\)"),
+    (lambda: ym.progress.Progress(np.nan), r"Progress end_time = nan s is outside"),
+    (lambda: ym.progress.Progress(-1.0), r"Progress end_time = -1.0 s is outside the allowed range \[0, inf\)"),
+    (lambda: ym.progress.Progress(1.0, interval=-1), r"Progress interval = -1 s is outside the allowed range \[0, inf\)"),
 ])
 def test_more_public_calls_name_the_parameter(call, msg):
     """Found by calling every public function with wrong types/NaN/inf/negatives/empty arrays/wrong

@@ -22,7 +22,7 @@ def test_apparent_modulus_skips_toe_and_post_peak():
 
 
 def test_overlapping_discs():
-    hole = ym.rotated_rectangle((0, 0), 0.02, 0.002, math.radians(30))
+    hole = ym.geometry.rotated_rectangle((0, 0), 0.02, 0.002, math.radians(30))
     xy = np.array([[0, 0], [0, 0.0015], [0, 0.003], [0.0105, 0], [0.013, 0]])
     r = np.full(5, 0.001)
     # centre inside; 1.5 mm above the axis: 0.3 mm from the band's edge (< r); 3 mm above: free;

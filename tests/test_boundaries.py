@@ -148,7 +148,7 @@ def test_points_inside_a_thin_gap_keep_a_valid_fit(width, angle, tied):
     # linear fields, wherever it lands between the faces.
     h = 0.05
     s = ym.make_solver((0, 0), (1.2, 1.2), h)
-    flaw = ym.rotated_rectangle((0.6, 0.6), 0.5, width * h, angle)
+    flaw = ym.geometry.rotated_rectangle((0.6, 0.6), 0.5, width * h, angle)
     ym.add_region(s, ym.ElasticMat(**MAT), (0, 0), (1.2, 1.2), holes=[flaw])
     assert np.any(s.excludedNodes() & GAP) == tied
     rng = np.random.default_rng(1)

@@ -13,6 +13,7 @@ import textwrap
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import views
 from yade_mpm import checkpoint
 
 yade = pytest.importorskip("yade")
@@ -46,7 +47,7 @@ exec(SCENE)   # defines build() here; the subprocess below runs the same text
 
 def _state(s):
     from yade import O
-    arrays = {k: np.array(v) for k, v in ym.views(s).items()}      # storage order: the order is state too
+    arrays = {k: np.array(v) for k, v in views(s).items()}      # storage order: the order is state too
     b = O.bodies[0].state
     return arrays, (tuple(b.pos), tuple(b.vel), tuple(b.angVel), tuple(b.ori)), (O.time, O.iter, O.dt, s.time, s.steps)
 
@@ -74,7 +75,7 @@ def test_resume_is_bitwise(tmp_path):
     assert s.steps == O.iter == N // 2 + 1
     O.run(N - N // 2 - 1, True)
     _assert_same(ref, _state(s))
-    assert ym.engine("mpmCk").solver is s
+    assert ym.engine.by_label("mpmCk").solver is s
 
 
 def test_solver_only_resume_is_bitwise(tmp_path):
@@ -101,8 +102,8 @@ def _assert_resume_bitwise(make, n, split, path, before_load=lambda b, c: None):
     before_load(b, c)
     checkpoint.load(path, solvers=c)
     c.run(n - split)
-    for k, v in ym.views(a).items():
-        np.testing.assert_array_equal(v, ym.views(c)[k], err_msg=k)
+    for k, v in views(a).items():
+        np.testing.assert_array_equal(v, views(c)[k], err_msg=k)
     assert (a.time, a.steps, a.lastDt) == (c.time, c.steps, c.lastDt) and a.settings() == c.settings()
     return c
 

@@ -85,7 +85,7 @@ def test_far_field_load_keeps_intact_block_in_equilibrium(mode, bound, ppc):
 def test_consistent_row_weights_refuse_one_particle_per_cell():
     # (Σβ = 1 holds by the normalisation; the weights are checked by the equilibrium test above.)
     with pytest.raises(ValueError, match=r"ppc .*consistent=False.* = 1 must be an integer in \[2, 16\]"):
-        ym.consistent_row_weights(1)
+        ym.scene.consistent_row_weights(1)
 
 
 def test_bad_input_is_refused(tmp_path):

@@ -5,6 +5,7 @@ a free YADE box coming to rest on a block and a thrown box conserving momentum, 
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import id_order
 
 G = 9.81
 ELASTIC = dict(young=2e7, poisson=0.25, density=1000.0)
@@ -33,7 +34,7 @@ def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5, shift=(0.0, 0.0, 0.0)
     s.addParticles(x, np.full(len(x), sp ** d), np.full(len(x), sp ** d * ELASTIC["density"]))
     s.gravity = (0, -G, 0)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=mu, cohesion=cohesion, chi=chi, d0=None))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=mu, cohesion=cohesion, chi=chi, d0=None))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), (1.0, 0.1, 1.0)[:d])
     s.setRigidPartState(p, c0 - 0.1 * R[:, 1], R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s, p, R[:, 0], l, s.view("mass").sum()
@@ -115,7 +116,7 @@ def _drop(d, chi=None):
     ym.add_region(s, ym.ElasticMat(young=1e6, poisson=0.25, density=1000.0), (0.1, 0.1, 0.04)[:d], (0.3, 0.2, 0.12)[:d])
     s.gravity = (0, -G, 0)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=None))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=None))
     n = np.zeros(d)
     n[1] = 1
     s.addContactPlane(g, p, np.zeros(d), n, False)   # the wall y = 0, material above
@@ -158,7 +159,7 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d, law, down, lif
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0.2, 0.2, 0.1)[:d], (0.8, 0.5, 0.5)[:d])
     s.gravity = (0.3, -G, 0.2)[:d]
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.4, cohesion=1e3, chi=0.5, d0=None, law=law))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.4, cohesion=1e3, chi=0.5, d0=None, law=law))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), (0.15, 0.1, 0.15)[:d])
     c = np.array([0.45, 0.59 + lift, 0.3][:d])
     R = _rot(d, 0.2)
@@ -192,8 +193,8 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d, law, down, lif
 def test_contact_is_bitwise_identical_for_1_and_2_threads(free, law, damping, monkeypatch):
     """free: the incline is a free part (its mass and inertia set; the stick step's body response); damping > 0: the
     late damping (and the kinematic law's second projection)."""
-    orig = ym.contact_params
-    monkeypatch.setattr(ym, "contact_params", lambda *a, **k: orig(*a, law=law, **k))
+    orig = ym.bodies.contact_params
+    monkeypatch.setattr(ym.bodies, "contact_params", lambda *a, **k: orig(*a, law=law, **k))
 
     def run(n):
         ym.setThreads(n)
@@ -318,7 +319,7 @@ def test_bad_contact_input_is_refused_naming_it():
     with pytest.raises(ValueError, match="does not cross the plane z = 0"):
         rb.add(far)
     with pytest.raises(ValueError, match="chi"):
-        s.addContactGroup([s.addRigidPart()], ym.contact_params(mu=0.0, cohesion=0.0, chi=1.0, d0=None))
+        s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=1.0, d0=None))
     assert not s.contactActive                       # nothing was registered by the refused calls
 
 
@@ -360,7 +361,7 @@ def test_uniaxial_builder_ramp_and_end_caps():
     from yade_mpm_paper import cases
     l, speed, ramp, caps = 0.005, 1.0, 2e-5, 2
     def eps0(solver):                                  # ε_D⁰ by particle id
-        return solver.view("eps0")[ym.id_order(solver)].copy()
+        return solver.view("eps0")[id_order(solver)].copy()
     e0_free = eps0(cases.uniaxial_flaw("intact", l, side_room=4 * l)[0])       # no caps: the rock's thresholds
     s, sc = cases.uniaxial_flaw("intact", l, platen_speed=speed, ramp_time=ramp, end_cap_cells=caps, side_room=4 * l)
     p = O.bodies[sc["platen"]]

@@ -14,6 +14,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import id_order
 from test_contact import ELASTIC, G, _rot
 
 SHIFTS = [(0.0, 0.0), (0.5, 0.5)] + [tuple(x) for x in np.random.default_rng(7).uniform(0, 1, (2, 2))]
@@ -45,7 +46,7 @@ def _corner_drop(d, shift):
     s.view("v1")[:] = -0.5
     s.gravity = tuple(-G if a == 1 else 0.0 for a in range(d))
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.3, cohesion=0.0, chi=0.5, d0=None))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.3, cohesion=0.0, chi=0.5, d0=None))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), np.full(d, h))
     s.setRigidPartState(p, c, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s, g, top, l
@@ -133,10 +134,10 @@ def test_platen_corner_at_courant_1(case):
     from yade_mpm_paper import cases
     s, sc = cases.arch_tunnel("intact", 2e-3) if case == "tunnel" else cases.uniaxial_flaw("open", 2e-3)
     s.courant = 1.0
-    o = ym.id_order(s)
+    o = id_order(s)
     V0, top = ym.get(s, "volume", o), ym.get(s, "pos", o)[:, 1].max()
     O.run(300, True)
-    o = ym.id_order(s)
+    o = id_order(s)
     J = ym.get(s, "volume", o) / V0
     near = ym.get(s, "pos", o)[:, 1] > top - 2e-3
     print(f"{case} at C = 1, 300 steps: J under the platen {J[near].min():.6f} … {J[near].max():.6f}, everywhere "

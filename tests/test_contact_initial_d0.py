@@ -29,7 +29,7 @@ def _lattice_with_box(theta, d=2):
     s.setMaterial(ym.ElasticMat(**ELASTIC))
     s.addParticles(x, np.full(len(x), dp ** d), np.full(len(x), dp ** d * ELASTIC["density"]))
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
     s.addContactBox(g, p, np.zeros(d), np.eye(d), half)
     s.setRigidPartState(p, centre, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     s.captureContactD0(g)
@@ -77,7 +77,7 @@ def _slab_on_block(d0, gap, l=0.02, chi=0.5):
     s = ym.make_solver((0, 0), (0.2, 0.2), l)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (0.2, 0.1), ppc=2)
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0, law="penalty"))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0, law="penalty"))
     s.addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
     s.setRigidPartState(p, (0.1, 0.1 + gap + 0.02), np.eye(2), (0, 0), 0.0)
     if d0 == "initial":
@@ -115,11 +115,11 @@ def test_initial_d0_bad_input_is_refused():
     s, p, dp = _slab_on_block(None, 0.0)
     for bad in ("Initial", "init", "", True):
         with pytest.raises(ValueError, match="d0"):
-            s.addContactGroup([s.addRigidPart()], ym.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=bad))
+            s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=bad))
     s = ym.make_solver((0, 0), (0.2, 0.2), 0.02)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (0.2, 0.1), ppc=2)
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
     s.addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
     s.setRigidPartState(p, (0.1, 0.1 + 0.02 - 0.006), np.eye(2), (0, 0), 0.0)   # 6 mm into the block
     with pytest.raises(ValueError, match="particle id .* inside the rigid body"):
@@ -129,7 +129,7 @@ def test_initial_d0_bad_input_is_refused():
         s.step()
     s.captureContactD0(g)
     s.step()
-    g2 = s.addContactGroup([s.addRigidPart()], ym.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
+    g2 = s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
     with pytest.raises(ValueError, match="not created with d0 = 'initial'"):
         s.captureContactD0(g2)
 

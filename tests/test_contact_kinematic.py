@@ -10,8 +10,8 @@ import test_contact as tc
 
 @pytest.fixture
 def kinematic(monkeypatch):
-    orig = ym.contact_params
-    monkeypatch.setattr(tc.ym, "contact_params", lambda *a, **k: orig(*a, law="kinematic", **k))
+    orig = ym.bodies.contact_params
+    monkeypatch.setattr(tc.ym.bodies, "contact_params", lambda *a, **k: orig(*a, law="kinematic", **k))
 
 
 @pytest.mark.parametrize("d", [2, 3])
@@ -53,7 +53,7 @@ def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping, s.courant = 0.5, courant
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, d0=None, law=law))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, d0=None, law=law))
     s.addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
     face, stop = H + 0.37e-3, H - 1e-4               # the top particles' faces are at H: contact from face = H
     while face > stop:

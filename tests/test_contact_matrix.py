@@ -16,6 +16,7 @@ C = 1 at the platen corner: tests/test_contact_corners.py):
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import id_order
 from test_contact import ELASTIC, G, _block_on_incline, _com, _rot
 
 SHIFTS = [(0.0, 0.0, 0.0)] + [tuple(x) for x in np.random.default_rng(1).uniform(0, 1, (7, 3))]
@@ -134,7 +135,7 @@ def test_block_on_rotating_plate_follows_it(omega):
     s.addParticles(X0, np.full(len(X0), sp ** 2), np.full(len(X0), sp ** 2 * ELASTIC["density"]))
     s.gravity = (0, -G)
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=1.0, cohesion=0.0, chi=0.5, d0=None))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=1.0, cohesion=0.0, chi=0.5, d0=None))
     s.addContactBox(g, p, np.zeros(2), np.eye(2), (0.4, 0.1))
     ramp, t_end, angle = 0.1, 0.15, 0.0
     s.setRigidPartState(p, c, np.eye(2), np.zeros(2), 0.0)
@@ -149,7 +150,7 @@ def test_block_on_rotating_plate_follows_it(omega):
         s.step()
         angle += w * s.lastDt
         if tau > ramp:
-            o = ym.id_order(s)
+            o = id_order(s)
             r = ym.get(s, "pos", o) - c
             vr = omega * np.column_stack([-r[:, 1], r[:, 0]])
             E.append(np.linalg.norm(ym.get(s, "vel", o) - vr, axis=1) / np.linalg.norm(vr, axis=1))
@@ -178,7 +179,7 @@ def test_held_column_with_damping_reaction_equals_section_force():
     s.addBoundaryPlane(0, -1, 0.0, "slip"), s.addBoundaryPlane(0, 1, W, "slip"), s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping = 0.5
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
     s.addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
     face, stop = H + 0.37e-3, H - 1e-4                      # platen face: start, and where it is held
     while face > stop:

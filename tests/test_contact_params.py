@@ -48,11 +48,11 @@ def test_contact_ranges_are_enforced_at_the_ends_and_round_trip():
                     setattr(c, p["name"], end)
             else:
                 setattr(c, p["name"], end)
-    c = ym.contact_params(mu=0.35, cohesion=2e5, chi=0.25, d0=0.004)
+    c = ym.bodies.contact_params(mu=0.35, cohesion=2e5, chi=0.25, d0=0.004)
     d = c.toDict()
     assert d == dict(law="kinematic", mu=0.35, cohesion=2e5, chi=0.25, d0=0.004, autoD0=False, initialD0=False)
     assert ym.ContactParams.fromDict(json.loads(json.dumps(d))).toDict() == d
-    assert ym.contact_params(d0="initial").toDict()["initialD0"] is True
+    assert ym.bodies.contact_params(d0="initial").toDict()["initialD0"] is True
 
 
 def test_doc_contact_md_holds_the_generated_table():

@@ -27,7 +27,7 @@ def _box_sliding_on_slab(d, mass, inertia, v0=0.1, pen=0.002):
     s = ym.make_solver(np.zeros(d), (0.4, 0.2, 0.2)[:d], L)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, 0.0, 0.05)[:d], (0.3, TOP, 0.15)[:d])
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
     half = (0.2, 0.02, 0.2)[:d]                  # flat bottom face over the whole slab: normals exactly −y
     s.addContactBox(g, p, np.zeros(d), np.eye(d), half)
     c = np.array((0.2, TOP + 0.02 - pen, 0.1)[:d])
@@ -79,7 +79,7 @@ def test_box_sheared_between_two_slabs_stops_both_faces():
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, 0.0), (0.3, TOP))
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, TOP + 0.06), (0.3, TOP + 0.12))
     p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    g = s.addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
     s.addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.2, 0.03 + 0.002))      # pressed 2 mm into both faces
     s.setRigidPartState(p, (0.2, TOP + 0.03), np.eye(2), (0.0, 0.0), 0.0)
     s.setRigidPartMass(p, M, inf)
@@ -102,7 +102,7 @@ def test_two_free_parts_of_one_group_each_take_their_own_response():
     s = ym.make_solver((0, 0), (0.4, 0.2), L)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.0, 0.0), (0.4, TOP))
     parts = [s.addRigidPart(), s.addRigidPart()]
-    g = s.addContactGroup(parts, ym.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    g = s.addContactGroup(parts, ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
     for k, p in enumerate(parts):
         s.addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.09, 0.02))
         s.setRigidPartState(p, (0.1 + 0.2 * k, TOP + 0.02 - 0.002), np.eye(2), (v0, 0.0), 0.0)

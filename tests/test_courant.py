@@ -17,20 +17,20 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 def test_setting_default_is_the_solver_default():
     s = ym.make_solver((0.0, 0.0), (1.0, 1.0), 0.1)
-    assert ym.setting_default("courant") == s.courant
-    assert ym.check_courant(None) == s.courant
-    assert ym.check_courant(0.25) == 0.25
+    assert ym.scene.setting_default("courant") == s.courant
+    assert ym.scene.check_courant(None) == s.courant
+    assert ym.scene.check_courant(0.25) == 0.25
 
 
 @pytest.mark.parametrize("bad", [0.0, -0.5, 1.5])
 def test_check_courant_names_the_option_and_range(bad):
     with pytest.raises(ValueError, match=r"--courant = .*\(0, 1\]"):
-        ym.check_courant(bad)
+        ym.scene.check_courant(bad)
 
 
 def test_unknown_setting_named():
     with pytest.raises(ValueError, match="unknown solver setting 'courantt'"):
-        ym.setting_default("courantt")
+        ym.scene.setting_default("courantt")
 
 
 @pytest.mark.parametrize("script", ["tunnel_spalling.py", "uniaxial_flaw.py", "circular_opening.py", "penny_crack.py"])
@@ -39,7 +39,7 @@ def test_scripts_read_the_solver_default(script):
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "py"))
     h = subprocess.run([sys.executable, script_path(script), "--help"], capture_output=True, text=True, env=env)
     assert h.returncode == 0, h.stderr
-    assert f"(default: the solver's, {ym.setting_default('courant'):g})" in " ".join(h.stdout.split())
+    assert f"(default: the solver's, {ym.scene.setting_default('courant'):g})" in " ".join(h.stdout.split())
     r = subprocess.run([sys.executable, script_path(script), "--out", "/nonexistent/x", "--courant", "1.5"],
                        capture_output=True, text=True, env=env)
     assert r.returncode != 0 and "--courant = 1.5" in r.stderr + r.stdout

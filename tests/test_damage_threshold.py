@@ -83,7 +83,7 @@ def test_regularised_threshold_scales_with_root_of_cell_size(reading):
 
 
 def upd(stress, de, D=0.0, eps0=1.0, dt=1e-7, epsP=0.0, **mat):
-    f = ym.dpgkPointUpdate2D
+    f = ym.materials.dpgkPointUpdate2D
     s, sd, e, d, mode, dl, nf = f(rocks.granite_dpgk(**mat), list(map(float, stress)), list(map(float, de)), epsP, D, eps0, dt)
     return np.array(s), np.array(sd), e, d
 
@@ -150,7 +150,7 @@ def test_flaw_population_statistics():
     # all 16 flaws of 4000 particles: mean count below ε equals kVε^m (Poisson), thresholds ascending
     mat = rocks.granite_dpgk(flawCount=16, flawSeed=11)
     ids = s.view("id")[:4000]
-    thr = np.array([ym.dpgkFlawThresholds(mat, scale, int(i), 16) for i in ids])
+    thr = np.array([ym.materials.dpgkFlawThresholds(mat, scale, int(i), 16) for i in ids])
     assert np.all(np.diff(thr, axis=1) > 0)
     assert thr[:, 0] == pytest.approx(eps0[:4000], rel=1e-15)    # storage order == id order before a step
     for lam in (0.5, 1.0, 3.0):
@@ -167,22 +167,22 @@ def test_flaws_cap_damage_by_activated_fraction():
     """A particle whose strain passes 3 of its 8 flaw thresholds grows D to at most 3/8."""
     mat = rocks.granite_dpgk(flawCount=8, flawSeed=5, plasticity=False)
     vol0, l = 1e-4, 0.02
-    scale = ym.dpgkThresholdScale(mat, vol0, l, 2)
+    scale = ym.materials.dpgkThresholdScale(mat, vol0, l, 2)
     assert scale == pytest.approx(eq37(vol0), rel=1e-12)           # default reading: V = vol0 (area × 1 m)
-    thr = ym.dpgkFlawThresholds(mat, scale, 42, 8)
+    thr = ym.materials.dpgkFlawThresholds(mat, scale, 42, 8)
     eb = 0.5 * (thr[2] + thr[3])                       # between the 3rd and 4th flaw
     e = eb * PMOD / (LAM + 2 * G)                      # uniaxial strain: ε̄ (Eq. 36) = e
     s, nf, d = [0.0] * 4, 0.0, 0.0
-    s, _, _, d, _, _, nf = ym.dpgkPointUpdate2D(mat, s, [e, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
+    s, _, _, d, _, _, nf = ym.materials.dpgkPointUpdate2D(mat, s, [e, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
     assert nf == 3
     for _ in range(200):
-        s, _, _, d, _, _, nf = ym.dpgkPointUpdate2D(mat, s, [0, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
+        s, _, _, d, _, _, nf = ym.materials.dpgkPointUpdate2D(mat, s, [0, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
     assert d == pytest.approx(3 / 8, rel=1e-12) and nf == 3
     # straining past the last flaw lets D reach 1
     e2 = (thr[7] * 1.01 - eb) * PMOD / (LAM + 2 * G)
-    s, _, _, d, _, _, nf = ym.dpgkPointUpdate2D(mat, s, [e2, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
+    s, _, _, d, _, _, nf = ym.materials.dpgkPointUpdate2D(mat, s, [e2, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
     for _ in range(200):
-        s, _, _, d, _, _, nf = ym.dpgkPointUpdate2D(mat, s, [0, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
+        s, _, _, d, _, _, nf = ym.materials.dpgkPointUpdate2D(mat, s, [0, 0, 0, 0], 0.0, d, thr[0], 1e-6, nFlaw=nf, vol0=vol0, id=42, spacing=l)
     assert nf == 8 and d == 1.0
 
 

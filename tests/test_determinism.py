@@ -17,6 +17,7 @@ CHILD = r"""
 import json, math, sys
 import numpy as np
 import yade_mpm as ym
+from yade_mpm.fields import views
 dim, nsteps, flaws = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 mat = ym.rocks.granite_dpgk(flawCount=flaws, flawSeed=3)   # flaws > 0: Benz–Asphaug population
 l = 0.01
@@ -47,7 +48,7 @@ ym.apply_traction(s, top, (2e6,) + (0.0,) * (dim - 1), l / 2)
 s.tractionRampTime = 1e-5
 s.run(nsteps)
 out = {}
-for name, arr in ym.views(s).items():
+for name, arr in views(s).items():
     out[name] = np.asarray(arr).tobytes().hex()
 out["eff"] = s.effectiveStress().tobytes().hex()
 out["time"] = s.time.hex()

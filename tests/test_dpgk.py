@@ -61,7 +61,7 @@ def cohesion(eps, ecrit=0.1, c0=C0):
 
 
 def upd(m, stress, de, epsP=0.0, D=0.0, eps0=1.0, dt=1e-6):
-    f = ym.dpgkPointUpdate2D if len(stress) == 4 else ym.dpgkPointUpdate3D
+    f = ym.materials.dpgkPointUpdate2D if len(stress) == 4 else ym.materials.dpgkPointUpdate3D
     s, sd, e, d, mode, dl = f(m, list(map(float, stress)), list(map(float, de)), epsP, D, eps0, dt)[:6]
     return np.array(s), np.array(sd), e, d, mode, dl
 

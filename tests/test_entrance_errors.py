@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import views
 from yade_mpm import checkpoint
 from yade_mpm_paper import cases
 from yade_mpm.checkpoint import resumable
@@ -26,7 +27,7 @@ def block():
 
 def test_id_view_is_read_only():
     s = block()
-    for v in (s.view("id"), ym.views(s)["id"]):
+    for v in (s.view("id"), views(s)["id"]):
         with pytest.raises(ValueError, match="read-only"):
             v[:] = 0                                     # duplicates would silently scramble every id-ordered field
     assert sorted(ym.get(s, "id")) == list(range(s.numParticles))

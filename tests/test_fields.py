@@ -3,6 +3,7 @@ named — the carried (damaged, Eq. 40) and the undamaged one — and the storag
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import FIELDS, id_order
 from yade_mpm import rocks
 
 
@@ -17,7 +18,7 @@ def test_damaged_and_undamaged_stress():
     s = dpgk_block()
     ids = ym.get(s, "id")
     D = np.where(ids % 2 == 0, 0.5, 0.0)                       # half the particles half damaged
-    s.view("damage")[:] = D[np.argsort(ym.id_order(s))]        # by storage slot: slot k holds id view("id")[k]
+    s.view("damage")[:] = D[np.argsort(id_order(s))]        # by storage slot: slot k holds id view("id")[k]
     s.requestSort()
     st, und = ym.get(s, "stress"), ym.get(s, "undamaged_stress")
     assert np.allclose(und, [1e6, -2e6, -0.3e6, 0.0])
@@ -34,10 +35,10 @@ def test_id_order_and_fields():
     s.requestSort()
     s.run(5)
     f = ym.fields(s)
-    assert set(f) == set(ym.FIELDS) | {"time", "steps"} and f["steps"] == 5
+    assert set(f) == set(FIELDS) | {"time", "steps"} and f["steps"] == 5
     assert np.array_equal(f["id"], np.arange(s.numParticles))  # row k = particle id k, whatever the storage order
     assert np.mean(f["pos"][:, 0] - x0[:, 0]) == pytest.approx(s.time * 1.0, rel=1e-6)   # momentum: equal masses at 1 m/s
-    o = ym.id_order(s)
+    o = id_order(s)
     assert np.array_equal(f["mass"], s.view("mass")[o]) and np.array_equal(f["undamaged_stress"][:, 1], s.view("sig1")[o])
 
 

@@ -161,10 +161,10 @@ def test_solver_settings_round_trip_all_or_nothing():
 
 def test_check_setting_uses_the_declared_range():
     """Scripts check options against the solver's declaration instead of repeating the range."""
-    assert ym.check_setting("damping", 0.5) == 0.5
+    assert ym.scene.check_setting("damping", 0.5) == 0.5
     with pytest.raises(ValueError, match=r"^--damping = 1 \[-\] is outside the allowed range \[0, 1\)"):
-        ym.check_setting("damping", 1.0, "--damping")
+        ym.scene.check_setting("damping", 1.0, "--damping")
     with pytest.raises(ValueError, match=r"courant = 0 \[-\] is outside the allowed range \(0, 1\]"):
-        ym.check_setting("courant", 0.0)
+        ym.scene.check_setting("courant", 0.0)
     with pytest.raises(ValueError, match="unknown solver setting 'dampng'"):
-        ym.check_setting("dampng", 0.5)
+        ym.scene.check_setting("dampng", 0.5)

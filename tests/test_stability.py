@@ -148,7 +148,7 @@ def test_case_stopped_by_an_error_when_expected_to_finish_is_failed(tmp_path):
     r, _ = st.run_case("forced", forced, fast=True, progress=False)
     assert r["outcome"] == "stopped_with_error" and r["error_message_clear"]
     assert r["passed"] is False
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
 
     def script(name):
         spec = importlib.util.spec_from_file_location(name, script_path(f"{name}.py"))

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
+from yade_mpm.fields import views
 from yade_mpm import analysis, checkpoint, rocks
 from yade_mpm_paper import cases
 
@@ -75,7 +76,7 @@ def test_filled_flaw_resumes_bitwise(tmp_path):
 
     def state(s, b):
         bs = [O.bodies[i].state for i in (b["platen"], b["filler"])]
-        return ({k: np.array(v) for k, v in ym.views(s).items()},
+        return ({k: np.array(v) for k, v in views(s).items()},
                 [(tuple(x.pos), tuple(x.vel), tuple(x.ori), tuple(x.angVel)) for x in bs], (O.iter, O.time, s.time))
 
     N = 40

@@ -38,7 +38,7 @@ def test_o_run_matches_direct_stepping():
     assert O.dt == a.lastDt < 1e-3                 # lowered to the MPM step used last
     for name in ("pos", "vel", "stress"):
         np.testing.assert_array_equal(ym.get(a, name), ym.get(b, name))
-    assert ym.engine("mpmHook") is e
+    assert ym.engine.by_label("mpmHook") is e
 
 
 def test_user_dt_below_stable_is_kept():

@@ -15,26 +15,23 @@ from . import _guards
 _guards.cap_omp_threads()   # before libgomp reads OMP_NUM_THREADS (loaded with _core)
 from . import parallel
 _core = parallel.load_core(__name__)   # the serial core, or under mpirun the MPI build (doc/scaling.md)
-from ._core import (Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, dpgkPointUpdate2D, dpgkPointUpdate3D,
-                    dpgkFlawThresholds, dpgkThresholdScale)
+from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, ContactParams
 from . import _core
 _guards.install(_core)      # Solver.view("id") read-only, Solver.reserve(n) checked against the memory
 _guards.cap_core_threads(_core)
 from .materials import ElasticMat, DpGkMat
-from .fields import get, fields, FIELDS, id_order, views, removed, SYM_NAMES
-from .scene import (check_setting, setting_default, courant_option, check_courant, make_solver, add_region, set_initial_stress, boundary_particles, apply_traction,
-                    apply_face_traction, consistent_row_weights)
-from .geometry import Circle, Box, Disc, Polygon, rotated_rectangle, fill_region
-from .engine import MpmEngine, engine
-from ._core import ContactParams
-from .bodies import RigidBodies, contact_params
+from .fields import get, fields, removed
+from .scene import make_solver, add_region, set_initial_stress, boundary_particles, apply_traction, apply_face_traction
+from .geometry import Box, Circle, Disc, Polygon
+from .engine import MpmEngine
+from .bodies import RigidBodies
 from .spheres import DemSpheres
-from .progress import Progress
-from . import rocks, runner, output  # noqa: E402  (rock sets, run loop, result files)
+from . import rocks, runner, output, analysis  # noqa: E402  (rock sets, run loop, result files, crack analytics)
 from . import checkpoint  # noqa: E402  (save/resume a whole simulation)
 
+# The public names, each with one line in doc/guide/api.md; everything else lives in its submodule
+# (yade_mpm.scene, .geometry, .fields, .engine, .bodies, .progress, .materials).
 __all__ = ["Solver2D", "Solver3D", "MpmSimulationError", "setThreads", "getThreads", "ElasticMat", "DpGkMat",
-           "check_setting", "setting_default", "courant_option", "check_courant", "make_solver", "add_region", "views", "get", "id_order", "removed", "set_initial_stress", "boundary_particles",
-           "apply_traction", "apply_face_traction", "consistent_row_weights", "Circle", "Box", "Disc", "Polygon", "rotated_rectangle", "fill_region", "MpmEngine", "engine", "RigidBodies", "ContactParams", "contact_params", "DemSpheres",
-           "Progress", "SYM_NAMES", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
-           "dpgkThresholdScale"]
+           "make_solver", "add_region", "set_initial_stress", "boundary_particles", "apply_traction", "apply_face_traction",
+           "Box", "Circle", "Disc", "Polygon", "get", "fields", "removed", "MpmEngine", "RigidBodies", "ContactParams",
+           "DemSpheres", "rocks", "runner", "output", "checkpoint", "analysis"]

@@ -7,7 +7,7 @@ iterPeriod=1 and initRun=True placed in O.engines like any engine:
 Each YADE iteration it advances the MPM particles by O.dt, lowering O.dt first when the MPM stable
 step requires it (and raising it back towards the step the user/DEM asked for when possible), so
 O.time and O.iter stay the simulation's clock. The PyRunner carries the label, and
-``yade_mpm.engine('mpm')`` returns this object from that label.
+``yade_mpm.engine.by_label('mpm')`` returns this object from that label.
 
 With rigid bodies (``bodies``, a ``yade_mpm.RigidBodies``), each step reads their kinematics from
 O.bodies before the MPM step and adds the contact reactions to O.forces after it, so the PyRunner must
@@ -17,7 +17,7 @@ from .progress import Progress
 _registry = {}
 
 
-def engine(label):
+def by_label(label):
     """The MpmEngine registered under a YADE engine label."""
     try:
         return _registry[label]
@@ -53,7 +53,7 @@ class MpmEngine:
     def runner(self):
         """The PyRunner to place in O.engines (before NewtonIntegrator)."""
         from yade.wrapper import PyRunner
-        cmd = f"__import__('yade_mpm').engine({self.label!r})._yade_step()"
+        cmd = f"__import__('yade_mpm').engine.by_label({self.label!r})._yade_step()"
         return PyRunner(command=cmd, iterPeriod=1, initRun=True, label=self.label)
 
     def checkpoint_state(self):

@@ -14,8 +14,10 @@ Angles are in radians, as everywhere in YADE (use ``math.radians``). ``dilatancy
 word) is an alias of ``dilationAngle`` (YADE's word, cf. ``JCFpmMat.jointDilationAngle``).
 """
 from ._core import ElasticMat, DpGkMat
+from ._core import dpgkPointUpdate2D, dpgkPointUpdate3D, dpgkFlawThresholds, dpgkThresholdScale  # noqa: F401  (the DP–GK point update alone, for tests and studies)
 
-__all__ = ["ElasticMat", "DpGkMat", "describe", "markdown_table"]
+__all__ = ["ElasticMat", "DpGkMat", "describe", "markdown_table", "dpgkPointUpdate2D", "dpgkPointUpdate3D", "dpgkFlawThresholds",
+           "dpgkThresholdScale"]
 
 
 def describe(cls):

@@ -67,7 +67,7 @@ def parse_args(argv=None):
                         "that are ≤ a and divide L/2)")
     p.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all cores)")
     p.add_argument("--progress", type=float, default=10.0, help="wall seconds between progress lines")
-    ym.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
+    ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
     p.add_argument("--no-vtu", dest="vtu", action="store_false", help="skip the VTU particle file")
     p.add_argument("--vtu-every", type=float, default=0.0,
                    help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "
@@ -89,9 +89,9 @@ def check_args(a):
     if a.ppc < 1 or a.ppc > 4:
         raise ValueError(f"--ppc = {a.ppc} must be in [1, 4]")
     if a.boundary_load == "consistent":
-        ym.consistent_row_weights(a.ppc)              # raises for ppc = 1
-    ym.check_setting("damping", a.damping, "--damping")  # the solver's declared range
-    a.courant = ym.check_courant(a.courant)
+        ym.scene.consistent_row_weights(a.ppc)              # raises for ppc = 1
+    ym.scene.check_setting("damping", a.damping, "--damping")  # the solver's declared range
+    a.courant = ym.scene.check_courant(a.courant)
     if not (math.isfinite(a.tol) and a.tol > 0):
         raise ValueError(f"--tol = {a.tol} must be > 0")
     if a.max_time is not None and not (math.isfinite(a.max_time) and a.max_time > 0):

@@ -46,6 +46,7 @@ import time
 import numpy as np
 
 import yade_mpm as ym
+from yade_mpm.fields import id_order
 from yade_mpm import rocks
 from yade_mpm_paper import cases
 from yade_mpm_paper.validation import bonded
@@ -143,7 +144,7 @@ def mpm_uniaxial(flaw, a):
                                 ramp_time=RAMP_TIME, end_cap_cells=CAP_CELLS if a.capped_ends else 0, side_room=8 * l)
     s.damping = DAMPING
     label = "mpm " + ("open flaw" if flaw else "intact")
-    prog = ym.Progress(a.max_strain, label, 20.0)
+    prog = ym.progress.Progress(a.max_strain, label, 20.0)
     strain, stress, peak = [0.0], [0.0], 0.0
     t0, c0 = time.time(), time.process_time()
     end_reason, error = "post_peak", ""
@@ -164,7 +165,7 @@ def mpm_uniaxial(flaw, a):
         if len(stress) > 3 and max(stress[-3:]) < 0.7 * peak:   # 3 records past a 30 % drop
             break
     wall, cpu = time.time() - t0, time.process_time() - c0
-    o = ym.id_order(s)
+    o = id_order(s)
     acc = s.removedAccount()                                   # debris that left the grid (Solver.outside)
     return dict(strain=np.array(strain), stress=np.array(stress), particles=int(s.numParticles + acc["count"]), wall_time_s=wall,
                 cpu_time_s=cpu, pos=ym.get(s, "pos", o), damage=ym.get(s, "damage", o), steps=int(s.steps), dt=float(s.lastDt),
@@ -180,7 +181,7 @@ def packing(a, lo, hi, r):
 
 
 def jcfpm_uniaxial(P, micro, holes, a, label):
-    prog = ym.Progress(a.dem_max_strain, label, 20.0)
+    prog = ym.progress.Progress(a.dem_max_strain, label, 20.0)
     res = bonded.uniaxial(P, micro, a.platen_speed, SAND["density"], holes=holes, max_strain=a.dem_max_strain, damping=DAMPING,
                           crack_dir=os.path.join(a.out, "jcfpm_cracks"), label=label, ramp_time=RAMP_TIME,
                           progress=lambda e, s: prog.update(0, e))

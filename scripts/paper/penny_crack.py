@@ -44,7 +44,7 @@ from yade_mpm_paper import batch, cases
 ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
 HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
 PAPER_RAMP = 0.5                       # s
-COURANT = ym.setting_default("courant")   # --courant sets it (default: the solver's C)
+COURANT = ym.scene.setting_default("courant")   # --courant sets it (default: the solver's C)
 SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
 
 
@@ -295,7 +295,7 @@ def main(argv=None):
     ap.add_argument("--vtu", action="store_true", help="also write VTU particle files of the damage snapshots")
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
     ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
-    ym.courant_option(ap)
+    ym.scene.courant_option(ap)
     a = batch.parse_args(ap, argv)    # the command line, or a yade-batch / scripts/studies/sweep.py table line
     parts = set(a.parts.split(","))
     if not parts <= {"elastic", "convergence", "damage"}:
@@ -314,7 +314,7 @@ def main(argv=None):
     HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
     global COURANT
     try:
-        COURANT = ym.check_courant(a.courant)
+        COURANT = ym.scene.check_courant(a.courant)
     except ValueError as e:
         ap.error(str(e))
     if a.full:

@@ -37,12 +37,12 @@ def parse(argv=None):
     p.add_argument("--only", choices=("2d", "3d"), default=None, help="run one of the two (the other is read from OUT)")
     p.add_argument("--end-time", type=float, default=END_TIME, help="loading time cap [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=60.0, help="wall seconds between progress lines")
-    ym.courant_option(p)
+    ym.scene.courant_option(p)
     a = p.parse_args(argv)
     if not (a.spacing > 0 and a.end_time > 0 and a.slab_cells >= 1):
         p.error("--spacing and --end-time must be > 0, --slab-cells ≥ 1")
     try:
-        a.courant = ym.check_courant(a.courant)
+        a.courant = ym.scene.check_courant(a.courant)
     except ValueError as e:
         p.error(str(e))
     return a

@@ -88,7 +88,7 @@ def read(path, check_build=True):
                               "only (checkpoints are not converted between formats: rerun from the start, or resume with the "
                               "yade_mpm version that wrote it)")
     if check_build:
-        check_build(path, header)
+        check_same_build(path, header)
     payload = raw[p + 8 + hl:]
     if len(payload) != header.get("payload_bytes"):
         raise CheckpointError(f"checkpoint {path}: truncated or padded (payload {len(payload)} bytes, "
@@ -100,7 +100,7 @@ def read(path, check_build=True):
     return header, arrays
 
 
-def check_build(path, header):
+def check_same_build(path, header):
     if header.get("build") != build_id():
         raise CheckpointError(f"checkpoint {path}: written by another build of the yade_mpm core ({header.get('build')}, "
                               f"this one is {build_id()}); a bitwise resume needs the same build — rerun from the start "

@@ -1,7 +1,9 @@
 """The state a checkpoint holds (solver arrays, YADE scene, MpmEngine registry), its fingerprints, and
 ``save`` / ``load`` of one process; N MPI ranks hand their pieces to mpi.py."""
+import hashlib
 import json
 import os
+import sys
 import time
 
 import numpy as np
@@ -10,7 +12,7 @@ from .. import _core
 from ..engine import MpmEngine, _registry as _engines
 from ..fields import SYM_NAMES, dim_of
 from . import mpi as cmpi
-from .format import FORMAT, CheckpointError, build_id, check_build, diff, read, write
+from .format import FORMAT, CheckpointError, build_id, check_same_build, diff, read, write
 
 _STATE_SCALARS = ("steps", "time", "lastDt", "externalWork", "vmax", "rhoMin", "massFloor", "needSort", "needCheck")
 
@@ -212,7 +214,7 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
                                                                  for lab, e in engines.items()})
     if not mpi:
         return write(path, header, arrays)
-    return cmpi.save_pieces(path, header, arrays, sol, _write)
+    return cmpi.save_pieces(path, header, arrays, sol, write)
 
 
 
@@ -224,7 +226,7 @@ def load(path, solvers=None, yade=None, meta=None):
     CheckpointError lists the differences. Returns the header (meta, time written, fingerprints)."""
     header, arrays = read(path, check_build=False)
     cmpi.refuse_other_count(path, header)   # N ranks resume only an N-rank checkpoint (before the build:
-    check_build(path, header)                               # 1 process and N ranks run different builds of the core)
+    check_same_build(path, header)                               # 1 process and N ranks run different builds of the core)
     if cmpi.active():
         return cmpi.load_piece(path, header, solvers, yade, meta, _load)
     return _load(path, header, arrays, solvers, yade, meta)
