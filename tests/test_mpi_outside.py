@@ -13,9 +13,9 @@ CHILD = r"""
 import sys
 import numpy as np
 import yade_mpm as ym
-from yade_mpm_paper.validation import stability as st
+from yade_mpm_paper.validation import stability_cases as sc
 damage, steps, out = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-s, block, frag = st.debris_scene(50.0)
+s, block, frag = sc.debris_scene(50.0)
 s.view("damage")[np.isin(s.view("id"), frag)] = damage
 s.requestSort()
 s.autoDt, s.fixedDt = False, 0.999 * s.courant * s.spacing / (s.waveSpeed() + 200.0)

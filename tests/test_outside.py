@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import yade_mpm as ym
-from yade_mpm_paper.validation import stability as st
+from yade_mpm_paper.validation import stability_cases as sc
 
-END = st.debris_end_time()
+END = sc.debris_end_time()
 
 
 def _fixed_dt(s):
@@ -16,7 +16,7 @@ def _fixed_dt(s):
 
 
 def _run(speed, fragment=True, threads=None, end=END):
-    s, block, frag = st.debris_scene(speed, fragment=fragment)
+    s, block, frag = sc.debris_scene(speed, fragment=fragment)
     s.autoDt, s.fixedDt = False, _fixed_dt(s)
     if threads:
         ym.setThreads(threads)
@@ -36,7 +36,7 @@ def reference():
     return ym.fields(s), block
 
 
-@pytest.mark.parametrize("speed", st.DEBRIS_SPEEDS)
+@pytest.mark.parametrize("speed", sc.DEBRIS_SPEEDS)
 def test_fragment_thrown_at_the_edge_is_removed_and_the_block_is_untouched(speed, reference):
     s, block, frag, f0 = _run(speed)
     assert s.time >= END * (1 - 1e-12)                            # the run reached its end time
@@ -66,7 +66,7 @@ def test_fragment_thrown_at_the_edge_is_removed_and_the_block_is_untouched(speed
 
 
 def test_intact_body_pushed_off_the_grid_stops_with_particle_face_and_position():
-    s, _ = st.case_grid_edge(True)
+    s, _ = sc.case_grid_edge(True)
     assert s.outside == "remove-debris"                            # the default
     with pytest.raises(ym.MpmSimulationError) as e:
         s.run(10000)
@@ -79,12 +79,12 @@ def test_intact_body_pushed_off_the_grid_stops_with_particle_face_and_position()
 
 
 def test_outside_policies_stop_and_remove():
-    s, _, frag = st.debris_scene(50.0)
+    s, _, frag = sc.debris_scene(50.0)
     s.outside = "stop"
     with pytest.raises(ym.MpmSimulationError, match=r"particle id \d+ left the grid along axis 0 through its x\+ face .*outside = 'stop'"):
         s.run(5000)
     # 'remove' takes out anything that leaves, the body too
-    s, _ = st.case_grid_edge(True)
+    s, _ = sc.case_grid_edge(True)
     s.outside = "remove"
     n = s.numParticles
     s.run(400)
@@ -96,7 +96,7 @@ def test_outside_policies_stop_and_remove():
 
 def test_detached_intact_fragment_is_debris():
     """An intact (D = 0) fragment apart from the block is detached from the body: removed."""
-    s, block, frag = st.debris_scene(50.0)
+    s, block, frag = sc.debris_scene(50.0)
     s.view("damage")[:] = 0.0
     s.requestSort()
     s.run(1500)
@@ -129,7 +129,7 @@ def test_one_and_two_threads_give_the_same_bits_with_a_removal():
 
 def test_checkpoint_after_a_removal_resumes_bit_identical(tmp_path):
     def build():
-        s, _, _ = st.debris_scene(50.0)
+        s, _, _ = sc.debris_scene(50.0)
         s.autoDt, s.fixedDt = False, _fixed_dt(s)
         return s
     s = build()

@@ -167,15 +167,15 @@ def test_solver_error_propagates_or_returns_with_its_message():
     """The intact body pushed off the grid (the stability suite's grid_edge case) stops the solver: by default the error
     propagates; with on_error="return" the run returns reason "error" with the solver's message and the steps it took;
     a bad on_error is named."""
-    from yade_mpm_paper.validation import stability as st
-    s, _ = st.case_grid_edge(True)
+    from yade_mpm_paper.validation import stability_cases as sc
+    s, _ = sc.case_grid_edge(True)
     with pytest.raises(ym.MpmSimulationError):
         runner.run(s, max_steps=10000)
-    s, _ = st.case_grid_edge(True)
+    s, _ = sc.case_grid_edge(True)
     r = runner.run(s, max_steps=10000, on_error="return")
     assert r.reason == "error" and "left the grid" in r.error and 0 < r.steps < 10000 and s.steps == r.steps
     assert "error=" in repr(r)
     with pytest.raises(ValueError, match="on_error = 'ignore' must be 'raise' or 'return'"):
         runner.run(s, max_steps=1, on_error="ignore")
-    s, _ = st.case_grid_edge(True)
+    s, _ = sc.case_grid_edge(True)
     assert runner.run(s, max_steps=1).error is None

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 import yade_mpm as ym
-from yade_mpm_paper.validation import stability as st
+from yade_mpm_paper.validation import stability as st, stability_cases as sc
 from helpers import script_path
 
 
@@ -18,9 +18,9 @@ def one_thread():
     ym.setThreads(old)
 
 
-@pytest.mark.parametrize("name", list(st.CASES))
+@pytest.mark.parametrize("name", list(sc.CASES))
 def test_case_is_stable(name):
-    r, h = st.run_case(name, st.CASES[name][0], fast=True, progress=False)
+    r, h = st.run_case(name, sc.CASES[name][0], fast=True, progress=False)
     assert not r["nan_seen"], r
     assert r["outcome"] == r["expected_outcome"], r["message"]
     assert r["steps"] > 50, "case too short to say anything"
@@ -40,7 +40,7 @@ def test_case_is_stable(name):
 
 
 def test_grid_edge_message_names_step_particle_and_position():
-    s, _ = st.case_grid_edge(True)
+    s, _ = sc.case_grid_edge(True)
     with pytest.raises(ym.MpmSimulationError) as e:
         for _ in range(10000):
             s.step()
@@ -57,13 +57,13 @@ def test_grid_edge_message_names_step_particle_and_position():
 
 
 def test_fully_damaged_band_stays_damaged_and_spreads():
-    r, _ = st.run_case("fully_damaged", st.case_damaged, fast=True, progress=False)
+    r, _ = st.run_case("fully_damaged", sc.case_damaged, fast=True, progress=False)
     # the pre-set band is 20 % of the particles; the tensile wave must damage more, never undo it
     assert r["fraction_fully_damaged"] > 0.2
 
 
 def test_column_collapses():
-    s, opts = st.case_column_collapse(True)
+    s, opts = sc.case_column_collapse(True)
     x0 = ym.get(s, "pos")
     s.run(200)
     while s.time < opts["end_time"]:
@@ -74,7 +74,7 @@ def test_column_collapses():
 
 
 def test_mass_contrast_step_follows_the_light_block():
-    s, _ = st.case_mass_contrast(True)
+    s, _ = sc.case_mass_contrast(True)
     m = s.elasticParameters()
     vc_light = math.sqrt((m.bulk() + 4 * m.shear() / 3) / 1.0)
     assert s.waveSpeed() == pytest.approx(vc_light, rel=1e-9)
@@ -82,7 +82,7 @@ def test_mass_contrast_step_follows_the_light_block():
 
 
 def test_step_above_the_stable_limit_is_refused():
-    s, _ = st.case_stiff(True)
+    s, _ = sc.case_stiff(True)
     s.run(5)
     lim = s.stableDt()
     with pytest.raises(ValueError, match="exceeds the stable time step"):
@@ -97,7 +97,7 @@ def test_step_above_the_stable_limit_is_refused():
 def test_energy_check_detects_injected_energy():
     """The bound is not vacuous: energy added behind the solver's back (a velocity kick that no
     external force paid for) pushes the ratio over 1 + tol."""
-    s, _ = st.case_stiff(True)
+    s, _ = sc.case_stiff(True)
     s.trackEnergy = True
     e0 = s.kineticEnergy() + s.elasticEnergy()
     tot, inp = [], []
@@ -116,7 +116,7 @@ def test_energy_check_detects_injected_energy():
 @pytest.mark.parametrize("field,value", [("x1", float("nan")), ("x1", 50.0), ("mass", float("nan")), ("vol", -1.0),
                                          ("sig0", float("inf")), ("v0", float("nan"))])
 def test_corrupted_state_is_refused_before_stepping(field, value):
-    s, _ = st.case_stiff(True)
+    s, _ = sc.case_stiff(True)
     s.run(3)
     s.view(field)[7] = value
     s.requestSort()
@@ -128,7 +128,7 @@ def test_corrupted_state_is_refused_before_stepping(field, value):
 def test_nan_stress_is_stopped_with_a_message():
     """A non-finite stress that reaches the step (written without requestSort) is caught within the
     step by the stress-update check, not propagated as garbage."""
-    s, _ = st.case_stiff(True)
+    s, _ = sc.case_stiff(True)
     s.run(3)
     s.view("sig0")[7] = float("nan")
     with pytest.raises(ym.MpmSimulationError, match=r"step 3 .*particle id \d+ has non-finite stress"):
@@ -143,7 +143,7 @@ def test_case_stopped_by_an_error_when_expected_to_finish_is_failed(tmp_path):
     import os
 
     def forced(fast):
-        s, opts = st.case_grid_edge(fast)
+        s, opts = sc.case_grid_edge(fast)
         return s, dict(opts, expect="finished")
     r, _ = st.run_case("forced", forced, fast=True, progress=False)
     assert r["outcome"] == "stopped_with_error" and r["error_message_clear"]
@@ -156,7 +156,7 @@ def test_case_stopped_by_an_error_when_expected_to_finish_is_failed(tmp_path):
         spec.loader.exec_module(m)
         return m
     stab = script("stability")
-    stab.CASES = dict(st.CASES, forced=(forced, "grid edge, declared as expected to finish"))
+    stab.CASES = dict(sc.CASES, forced=(forced, "grid edge, declared as expected to finish"))
     assert stab.main(["--out", str(tmp_path / "stability"), "--fast", "--cases", "forced,grid_edge"]) == 1
     s = json.load(open(tmp_path / "stability" / "summary.json"))
     assert s["all_passed"] is False and [c["passed"] for c in s["cases"]] == [False, True]

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Stability suite (issue 3, part 3): small scenes that push the explicit WLS-MPM step to its limits.
 
-The scenes and the per-step checks (finite state, energy bound, Δt within the stable limit, clear
-stop messages) live in yade_mpm_paper.validation.stability; this script runs them and writes the table and plots.
+The scenes live in yade_mpm_paper.validation.stability_cases, the per-step checks (finite state, energy bound,
+Δt within the stable limit, clear stop messages) in yade_mpm_paper.validation.stability; this script runs them
+and writes the table and plots.
 
 Usage: /usr/bin/python3 scripts/paper/stability.py --out DIR [--fast] [--cases a,b]
 Writes DIR/summary.json ("cases": list of {case, outcome, nan_seen, max_energy_ratio, steps,
@@ -14,7 +15,8 @@ import sys
 
 import numpy as np
 import yade_mpm as ym
-from yade_mpm_paper.validation.stability import CASES, ENERGY_FLOOR, ENERGY_TOL, run_case
+from yade_mpm_paper.validation.stability import ENERGY_FLOOR, ENERGY_TOL, run_case
+from yade_mpm_paper.validation.stability_cases import CASES
 
 
 def print_table(rows, stream=sys.stdout):

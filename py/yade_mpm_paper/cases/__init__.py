@@ -16,8 +16,8 @@ scenes here and keep only their command line, plots and narrative.
     uniaxial_results  a uniaxial flaw run's records: post-peak stop, peak and modulus, end-of-run crack
                       analytics, the runs' summary (scripts/paper/uniaxial_flaw.py)
 
-Rock parameters come from ``yade_mpm.rocks``; the small scenes of the stability suite live with their
-checks in ``yade_mpm_paper.validation.stability``. Modules: elastic (Secs. 3.1, 3.2, boundary checks),
+Rock parameters come from ``yade_mpm.rocks``; the small scenes of the stability suite live beside their
+checks in ``yade_mpm_paper.validation.stability_cases``. Modules: elastic (Secs. 3.1, 3.2, boundary checks),
 tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies), tunnel_results, uniaxial_results
 (imported by name: ``from yade_mpm_paper.cases import tunnel_results``). Quantities are SI; stresses are tension positive inside the solver.
 """
