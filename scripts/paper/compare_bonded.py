@@ -49,7 +49,7 @@ import yade_mpm as ym
 from yade_mpm.fields import id_order
 from yade_mpm import rocks
 from yade_mpm_paper import cases
-from yade_mpm_paper.validation import bonded
+from yade_mpm_paper.validation import bonded, bonded_figures
 from yade_mpm import output as out
 
 MPa, GPa = 1e6, 1e9
@@ -214,67 +214,6 @@ def calibrate(P, target_E, target_peak, a):
     return micro, res, rows, time.time() - t0
 
 
-# ------------------------------------------------------------------------------------------ figures
-def write_curve(path, strain, stress):
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["axial_strain", "axial_stress_MPa"])
-        w.writerows(zip(np.round(strain, 8), np.round(np.asarray(stress) / MPa, 5)))
-
-
-def plot_curves(path, results):
-    plt = out.pyplot()
-    fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.2), squeeze=False)
-    for ax, (case, r) in zip(axes[0], results.items()):
-        for meth, style in (("mpm", "k-"), ("jcfpm", "r-")):
-            if meth in r:
-                q = r[meth]
-                ax.plot(100 * np.asarray(q["strain"]), np.asarray(q["stress"]) / MPa, style,
-                        label=f"{'MPM (DP–GK)' if meth == 'mpm' else 'JCFpm'}: E = {q['youngs_modulus'] / GPa:.2f} GPa, "
-                              f"peak {q['peak_stress'] / MPa:.1f} MPa")
-        ax.set_xlabel("axial strain [%]")
-        ax.set_ylabel("axial stress [MPa]")
-        ax.set_title(case.replace("_", " "))
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-
-
-def plot_cracks(path, mpm, dem, holes, title):
-    plt = out.pyplot()
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Circle as CircleP, Polygon as PolyP
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(7, 8.5))
-    if mpm is not None:
-        sc = a1.scatter(mpm["pos"][:, 0] * 1e3, mpm["pos"][:, 1] * 1e3, c=mpm["damage"], s=1.0, cmap="inferno_r",
-                        vmin=0, vmax=1, marker="s", linewidths=0)
-        fig.colorbar(sc, ax=a1, shrink=0.6, label="damage D")
-    a1.set_title(f"MPM: damage D ({mpm['particles'] if mpm else 0} particles)", fontsize=9)
-    P = dem["discs"]
-    a2.add_collection(PatchCollection([CircleP((x * 1e3, y * 1e3), r * 1e3) for x, y, r in P], facecolor="0.85",
-                                      edgecolor="0.6", linewidths=0.2))
-    c = dem["cracks"]
-    for typ, col, name in ((0, "tab:red", "tensile"), (1, "tab:blue", "shear")):
-        m = c[:, 2] == typ
-        a2.plot(c[m, 0] * 1e3, c[m, 1] * 1e3, ".", ms=2.0, color=col, label=f"{name} ({int(m.sum())})")
-    a2.legend(fontsize=8, loc="upper right")
-    a2.set_title(f"JCFpm: broken bonds ({len(P)} spheres)", fontsize=9)
-    for ax in (a1, a2):
-        for h in holes:
-            ax.add_patch(PolyP(h.v * 1e3, closed=True, fill=False, ec="g", lw=0.8))
-        ax.set_aspect("equal")
-        ax.set_xlim(-2, 52)
-        ax.set_ylim(-2, 152)
-        ax.set_xlabel("x [mm]")
-    a1.set_ylabel("y [mm]")
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-
-
 # ------------------------------------------------------------------------------------------- parts
 def uniaxial_part(a, summary):
     lo, hi = (0.0, 0.0), SPECIMEN
@@ -300,7 +239,7 @@ def uniaxial_part(a, summary):
     results["open_flaw"] = dict(mpm=mpm_fl, jcfpm=dem_fl)
     for case, r in results.items():
         for meth, q in r.items():
-            write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
+            bonded_figures.write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
             summary.setdefault(case, {})[meth] = dict(youngs_modulus_GPa=q["youngs_modulus"] / GPa,
                                                       peak_stress_MPa=q["peak_stress"] / MPa,
                                                       particles=int(q["particles"]), wall_time_s=q["wall_time_s"],
@@ -314,13 +253,13 @@ def uniaxial_part(a, summary):
         for h in (holes if case == "open_flaw" else ()):
             keep &= ~bonded.overlapping(h, P[:, :2], P[:, 2])
         r["jcfpm"]["discs"] = P[keep]
-        plot_cracks(os.path.join(a.out, f"cracks_{case}.png"), r["mpm"], r["jcfpm"], holes if case == "open_flaw" else [],
-                    f"{case.replace('_', ' ')}: end of the run (MPM ε = {100 * r['mpm']['strain'][-1]:.2f} %, "
-                    f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
+        bonded_figures.plot_cracks(os.path.join(a.out, f"cracks_{case}.png"), r["mpm"], r["jcfpm"], holes if case == "open_flaw" else [],
+                                   f"{case.replace('_', ' ')}: end of the run (MPM ε = {100 * r['mpm']['strain'][-1]:.2f} %, "
+                                   f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
         for meth in ("jcfpm",):
             q = r[meth]
             summary[case][meth].update(tensile_cracks=q["tensile_cracks"], shear_cracks=q["shear_cracks"], bonds=q["bonds"])
-    plot_curves(os.path.join(a.out, "stress_strain.png"), results)
+    bonded_figures.plot_curves(os.path.join(a.out, "stress_strain.png"), results)
     summary["calibration"] = dict(procedure="fixed-point scaling: young *= E_mpm/E, tensile and cohesion *= peak_mpm/peak; "
                                             f"ks/kn = {KS_KN}, cohesion/tensile = {COH_OVER_TENS}, friction = {FRICTION_DEG:.1f} deg",
                                   runs=rows, wall_time_s=t_cal, micro=micro.as_dict(), packing_wall_time_s=t_pack,
@@ -375,25 +314,7 @@ def kirsch_part(a, summary):
     summary["kirsch_setup"] = dict(domain_m=L, hole_radius_m=cases.OPENING_RADIUS, far_field_MPa=[cases.OPENING_SXX / MPa,
                                    cases.OPENING_SYY / MPa], jcfpm_window_radius_m=0.5 * cases.OPENING_RADIUS,
                                    time="cpu_time_s: CPU seconds of the one-thread run; wall_time_s depends on the host load")
-    plt = out.pyplot()
-    fig, ax = plt.subplots(figsize=(6.2, 4.4))
-    for meth, col, mk, name in (("mpm", "k", "o", "MPM (grid spacing l)"), ("jcfpm", "r", "s", "JCFpm (mean radius r̄)")):
-        q = [r for r in rows if r["method"] == meth]
-        t = [r["cpu_time_s"] for r in q]
-        ax.loglog(t, [100 * r["l2_rel_error_max"] for r in q], "-", color=col, marker=mk, label=f"{name}: r ≥ 2a")
-        ax.loglog(t, [100 * r["l2_rel_error_near_max"] for r in q], "--", color=col, marker=mk, mfc="none",
-                  label=f"{name}: 2a ≤ r ≤ 5a")
-        for r in q:
-            ax.annotate(f"{r['resolution_m'] * 1e3:g} mm, {r['particles']}", (r["cpu_time_s"], 100 * r["l2_rel_error_max"]),
-                        fontsize=7, textcoords="offset points", xytext=(4, 3))
-    ax.set_xlabel("run time [CPU s, one thread]")
-    ax.set_ylabel("max relative L2 error of σxx, σyy vs Kirsch [%]")
-    ax.set_title(f"circular opening: {L} m block, a = {cases.OPENING_RADIUS} m, far field 20/10 MPa", fontsize=9)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "kirsch_error_vs_time.png"), dpi=130)
-    plt.close(fig)
+    bonded_figures.plot_kirsch_error_vs_time(os.path.join(a.out, "kirsch_error_vs_time.png"), rows, L, cases.OPENING_RADIUS)
 
 
 def main(argv=None):

@@ -6,6 +6,7 @@ them): analytic solutions and the suites that compare the solver with them.
     stability        the stability suite: the per-step checks and the checked run (doc/stability.md)
     stability_cases  its small extreme scenes (CASES)
     bonded           YADE's bonded-particle model (JCFpm) on the same cases (doc/mpm_vs_bonded.md)
+    bonded_figures   the figures of the MPM vs JCFpm comparison (scripts/paper/compare_bonded.py)
 
     from yade_mpm_paper.validation import kirsch, stability
 """
