@@ -35,8 +35,8 @@ import numpy as np
 
 import yade_mpm as ym
 import yade_mpm.output as out
-from yade_mpm_paper.validation import sneddon
-from yade_mpm_paper.validation.line_crack import PAPER_CELL, PAPER_DA, crack_extension, interp_da, paper_comparison
+from yade_mpm_paper.validation import line_crack_figures, sneddon
+from yade_mpm_paper.validation.line_crack import PAPER_DA, crack_extension, elastic_profiles, face_opening, interp_da, paper_comparison
 
 from yade_mpm import rocks, runner
 from yade_mpm_paper import batch, cases
@@ -62,15 +62,6 @@ def build(size, h, material, P, ramp, damping, crack_nodes="shared", edges="free
     return s, geo
 
 
-def face_opening(s, geo):
-    """Half crack opening (u_top − u_bot)/2 per column along the crack: (x − xc, u_y)."""
-    u = ym.get(s, "pos") - geo["x0"]
-    t, b = geo["top"], geo["bot"]
-    ot, ob = np.argsort(geo["x0"][t, 0]), np.argsort(geo["x0"][b, 0])
-    x = geo["x0"][t[ot], 0] - geo["xc"]
-    return x, 0.5 * (u[t[ot], 1] - u[b[ob], 1])
-
-
 def run_elastic(size, h, P, args):
     """Quasi-static elastic run; returns a dict of profiles and errors."""
     mat = rocks.granite()
@@ -92,51 +83,8 @@ def run_elastic(size, h, P, args):
     runner.run(s, end_time=args.elastic_max_transits * transit, progress=args.progress, label=f"elastic h={h}",
                every=[(0.25 * transit, check)])
     wall = time.time() - t0
-    x, uy = face_opening(s, geo)
-    ua = sneddon.opening_displacement(x, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
-    centre = np.argsort(np.abs(x))[:2]
-    uy_centre_err = (uy[centre].mean() - ua[centre].mean()) / ua[centre].mean()
-    uy_l2 = math.sqrt(np.sum((uy - ua) ** 2) / np.sum(ua ** 2))
-    # σ on the crack line ahead of both tips: the two particle rows at y = yc ± dp/2
-    pos, st = geo["x0"], ym.get(s, "stress")
-    line = np.abs(pos[:, 1] - geo["yc"]) < geo["dp"] * 0.75
-    xr = pos[line, 0] - geo["xc"]
-    ahead = np.abs(xr) > HALF_CRACK
-    xa = np.abs(xr[ahead])
-    syy, sxx = st[line, 1][ahead], st[line, 0][ahead]
-    order = np.argsort(xa)
-    xa, syy, sxx = xa[order], syy[order], sxx[order]
-    # mean over the 4 particles (2 rows × 2 tips) at each |x|
-    xu, inv = np.unique(np.round(xa, 9), return_inverse=True)
-    syy_m = np.bincount(inv, syy) / np.bincount(inv)
-    sxx_m = np.bincount(inv, sxx) / np.bincount(inv)
-    sa = sneddon.stress_ahead(xu, P, HALF_CRACK)
-    far = (xu > HALF_CRACK + 2 * h) & (xu < HALF_CRACK + 1.0)   # beyond the smoothed tip zone
-    syy_l2 = math.sqrt(np.sum((syy_m[far] - sa[far]) ** 2) / np.sum(sa[far] ** 2))
-    return dict(h=h, size=size, particles=s.numParticles, steps=s.steps, t=s.time, wall=wall,
-                uy_centre_err=uy_centre_err, uy_l2=uy_l2, syy_l2_far=syy_l2, x=x, uy=uy, ua=ua,
-                xs=xu, syy=syy_m, sxx=sxx_m, sa=sa, ke=s.kineticEnergy())
-
-
-def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
-    """Damage on the particles' initial lattice (one pixel per particle; the hole is white)."""
-    plt = out.pyplot()
-    x0, dmg, dp = geo["x0"], ym.get(s, "damage"), geo["dp"]
-    ix, iy = np.floor(x0[:, 0] / dp).astype(int), np.floor(x0[:, 1] / dp).astype(int)
-    img = np.full((iy.max() + 1, ix.max() + 1), np.nan)
-    img[iy, ix] = dmg
-    fig, ax = plt.subplots(figsize=(9, 3.2))
-    im = ax.imshow(img, origin="lower", extent=(0, dp * img.shape[1], 0, dp * img.shape[0]), cmap="jet",
-                   vmin=0, vmax=1, interpolation="nearest")
-    fig.colorbar(im, ax=ax, label="damage D")
-    ax.set_xlim(geo["xc"] - half_width, geo["xc"] + half_width)
-    ax.set_ylim(geo["yc"] - half_height, geo["yc"] + half_height)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    prof = elastic_profiles(s, geo, P, h, HALF_CRACK, ROCK["young"], ROCK["poisson"])
+    return dict(h=h, size=size, particles=s.numParticles, steps=s.steps, t=s.time, wall=wall, **prof, ke=s.kineticEnergy())
 
 
 CHOICES = {p["name"]: p["choices"] for p in ym.DpGkMat.paramTable() if p["type"] == "choice"}   # named options
@@ -173,7 +121,7 @@ def run_damage(args, law, outdir):
     def snapshot(tp):
         def write(s):
             tag = f"{law}_t{tp:.2f}s"
-            damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
+            line_crack_figures.damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
                        f"D, growth law {law}, t_paper = {tp} s (P = {args.damage_pressure * tp / PAPER_RAMP / 1e6:.0f} MPa)")
             if args.vtu:
                 out.write_particles(os.path.join(outdir, f"damage_{tag}.vtu"), s)
@@ -196,64 +144,8 @@ def run_damage(args, law, outdir):
                 ramp=ramp, scale=scale, h=h, size=size)
 
 
-def plot_elastic(e, outdir, P):
-    plt = out.pyplot()
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    xf = np.linspace(-HALF_CRACK, HALF_CRACK, 201)
-    ax[0].plot(xf, 1e3 * sneddon.opening_displacement(xf, P, ROCK["young"], ROCK["poisson"], HALF_CRACK), "k-",
-               label="Sneddon (Eq. 43)")
-    ax[0].plot(e["x"], 1e3 * e["uy"], "s", mfc="none", ms=4, label=f"MPM, l = {e['h']} m")
-    ax[0].set_xlabel("x − x_c [m]")
-    ax[0].set_ylabel("u_y [mm]")
-    ax[0].legend()
-    xs = np.linspace(HALF_CRACK * 1.0005, HALF_CRACK + 1.0, 400)
-    ax[1].plot(xs, sneddon.stress_ahead(xs, P, HALF_CRACK) / 1e6, "k-", label="Eq. 44")
-    ax[1].plot(e["xs"], e["syy"] / 1e6, "s", mfc="none", ms=4, label="MPM σ_yy")
-    ax[1].plot(e["xs"], e["sxx"] / 1e6, "o", mfc="none", ms=3, label="MPM σ_xx")
-    ax[1].set_xlim(HALF_CRACK, HALF_CRACK + 1.0)
-    ax[1].set_ylim(-5, 45)
-    ax[1].set_xlabel("|x − x_c| [m]")
-    ax[1].set_ylabel("σ [MPa]")
-    ax[1].legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "elastic_profiles.png"), dpi=150)
-    plt.close(fig)
-
-
-def plot_convergence(conv, outdir):
-    plt = out.pyplot()
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    w = [c["wall"] for c in conv]
-    ax.loglog(w, [abs(c["uy_centre_err"]) for c in conv], "o-", label="|u_y centre error|")
-    ax.loglog(w, [c["uy_l2"] for c in conv], "s-", label="u_y rel. L2 error")
-    for c in conv:
-        ax.annotate(f"l={c['h']}", (c["wall"], c["uy_l2"]), fontsize=8)
-    ax.set_xlabel("wall time [s]")
-    ax.set_ylabel("relative error")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "error_vs_walltime.png"), dpi=150)
-    plt.close(fig)
-
-
-def plot_da(results, outdir):
-    plt = out.pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for r in results:
-        t = [row[0] for row in r["rows"]]
-        cells = PAPER_CELL / r["h"]
-        ax.plot(t, [0.5 * (row[2] + row[3]) / cells for row in r["rows"]], "-",
-                label=f"MPM, growth law {r['law']} ({'ε̄^(m/3)' if r['law'] == 'benz-asphaug' else 'ε̄^(1/3), as printed'})")
-    ax.plot([p[0] for p in PAPER_DA], [p[1] for p in PAPER_DA], "ks", label="paper Fig. 9")
-    ax.set_xlabel("t (paper time scale) [s]")
-    ax.set_ylabel("Δa [cells of 0.02 m]")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "crack_extension.png"), dpi=150)
-    plt.close(fig)
-
-
-def main(argv=None):
+def option_parser():
+    """The command line (every option; a yade-batch / sweep table line sets the same names)."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True, help="output directory")
     ap.add_argument("--parts", default="elastic,convergence,damage", help="comma list of elastic, convergence, damage")
@@ -296,6 +188,12 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
     ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
     ym.scene.courant_option(ap)
+    return ap
+
+
+def parse_options(argv):
+    """The checked options, the parts to run and the Courant number; a bad option exits (status 2) before any run."""
+    ap = option_parser()
     a = batch.parse_args(ap, argv)    # the command line, or a yade-batch / scripts/studies/sweep.py table line
     parts = set(a.parts.split(","))
     if not parts <= {"elastic", "convergence", "damage"}:
@@ -310,91 +208,99 @@ def main(argv=None):
     for law in a.laws.split(","):
         if law not in CHOICES["growthLaw"]:
             ap.error(f"--laws: {law!r} is not one of {CHOICES['growthLaw']}")
-    global HALF_CRACK
-    HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
-    global COURANT
     try:
-        COURANT = ym.scene.check_courant(a.courant)
+        courant = ym.scene.check_courant(a.courant)
     except ValueError as e:
         ap.error(str(e))
-    if a.full:
-        a.spacing = 0.02
-    if a.threads > 0:
-        ym.setThreads(a.threads)
-    os.makedirs(a.out, exist_ok=True)
-    summary = dict(config=dict(size_m=a.size, elastic_spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
-                               ramp_time_s=PAPER_RAMP if a.full else a.ramp_time, paper_ramp_s=PAPER_RAMP,
-                               full=a.full, elastic_damping=a.elastic_damping, damage_damping=a.damage_damping,
-                               threshold_volume=rocks.granite_dpgk(**damage_options(a, "benz-asphaug")).thresholdVolume,
-                               damage_strain=a.damage_strain,
-                               threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
-                               edges=a.edges, edge_set=a.edge_set, courant=COURANT, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
-                               threads=ym.getThreads()))
-    wall0 = time.time()
-    particles = 0
-    stopped = []                        # runs the solver stopped: named with the message, the other runs still run
+    return a, parts, courant
 
-    def attempt(name, fn, *args):
-        try:
-            return fn(*args)
-        except (ym.MpmSimulationError, RuntimeError) as err:
-            stopped.append(dict(run=name, error=str(err)))
-            print(f"[penny_crack] {name} stopped: {err}", flush=True)
-            return None
-    e = None
-    if "elastic" in parts:
-        e = attempt(f"elastic l={a.spacing:g}", run_elastic, a.size, a.spacing, a.elastic_pressure, a)
-    if e is not None:
-        particles = max(particles, e["particles"])
-        out.write_csv(os.path.join(a.out, "elastic_uy.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
-                      zip(e["x"], e["uy"], e["ua"]))
-        out.write_csv(os.path.join(a.out, "elastic_stress_ahead.csv"), ["abs_x_minus_xc_m", "syy_mpm_Pa", "sxx_mpm_Pa", "s_eq44_Pa"],
-                      zip(e["xs"], e["syy"], e["sxx"], e["sa"]))
-        plot_elastic(e, a.out, a.elastic_pressure)
-        summary.update(uy_center_rel_error=e["uy_centre_err"], uy_l2_rel_error=e["uy_l2"],
-                       syy_ahead_l2_rel_error=e["syy_l2_far"], elastic_wall_time_s=e["wall"],
-                       elastic_particles=e["particles"], elastic_steps=e["steps"], elastic_time_s=e["t"],
-                       elastic_final_kinetic_energy_J=e["ke"])
-        print(f"elastic l={a.spacing}: u_y centre error {e['uy_centre_err']:+.4f}, L2 {e['uy_l2']:.4f}, "
-              f"σyy L2 (2 cells..1 m ahead) {e['syy_l2_far']:.4f}, wall {e['wall']:.1f} s", flush=True)
-    if "convergence" in parts:
-        conv = []
-        for h in [float(v) for v in a.conv_spacings.split(",")]:
-            same = "elastic" in parts and abs(h - a.spacing) < 1e-12
-            c = e if same else attempt(f"convergence l={h:g}", run_elastic, a.size, h, a.elastic_pressure, a)
-            if c is None:
-                continue
-            conv.append(c)
-            out.write_csv(os.path.join(a.out, f"elastic_uy_l{h:g}.csv"), ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"],
-                          zip(c["x"], c["uy"], c["ua"]))
-            print(f"convergence l={h}: centre {c['uy_centre_err']:+.4f}, L2 {c['uy_l2']:.4f}, wall {c['wall']:.1f} s", flush=True)
-        out.write_csv(os.path.join(a.out, "error_vs_walltime.csv"),
-                      ["spacing_m", "particles", "steps", "wall_s", "uy_center_rel_error", "uy_l2_rel_error", "syy_ahead_l2_rel_error"],
-                      [(c["h"], c["particles"], c["steps"], c["wall"], c["uy_centre_err"], c["uy_l2"], c["syy_l2_far"]) for c in conv])
-        if conv:
-            plot_convergence(conv, a.out)
-        summary["convergence"] = [dict(spacing_m=c["h"], particles=c["particles"], wall_time_s=c["wall"],
-                                       uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
+
+def run_config(a):
+    """summary.json's "config": which configuration ran."""
+    return dict(size_m=a.size, elastic_spacing_m=a.spacing, damage_spacing_m=a.damage_spacing,
+                ramp_time_s=PAPER_RAMP if a.full else a.ramp_time, paper_ramp_s=PAPER_RAMP,
+                full=a.full, elastic_damping=a.elastic_damping, damage_damping=a.damage_damping,
+                threshold_volume=rocks.granite_dpgk(**damage_options(a, "benz-asphaug")).thresholdVolume,
+                damage_strain=a.damage_strain,
+                threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
+                edges=a.edges, edge_set=a.edge_set, courant=COURANT, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
+                threads=ym.getThreads())
+
+
+def attempt(stopped, name, fn, *args):
+    """fn(*args), or None when the solver stops it: the run is named in `stopped` with its message and the other runs still run."""
+    try:
+        return fn(*args)
+    except (ym.MpmSimulationError, RuntimeError) as err:
+        stopped.append(dict(run=name, error=str(err)))
+        print(f"[penny_crack] {name} stopped: {err}", flush=True)
+        return None
+
+
+def write_uy(path, run):
+    """The opening along the crack of an elastic run beside Sneddon's."""
+    out.write_csv(path, ["x_minus_xc_m", "uy_mpm_m", "uy_sneddon_m"], zip(run["x"], run["uy"], run["ua"]))
+
+
+def elastic_part(a, stopped, summary):
+    """The elastic run at --spacing: profiles (CSV, figure) and errors into the summary; returns the run or None."""
+    e = attempt(stopped, f"elastic l={a.spacing:g}", run_elastic, a.size, a.spacing, a.elastic_pressure, a)
+    if e is None:
+        return None
+    write_uy(os.path.join(a.out, "elastic_uy.csv"), e)
+    out.write_csv(os.path.join(a.out, "elastic_stress_ahead.csv"), ["abs_x_minus_xc_m", "syy_mpm_Pa", "sxx_mpm_Pa", "s_eq44_Pa"],
+                  zip(e["xs"], e["syy"], e["sxx"], e["sa"]))
+    line_crack_figures.plot_elastic(e, a.out, a.elastic_pressure, HALF_CRACK, ROCK)
+    summary.update(uy_center_rel_error=e["uy_centre_err"], uy_l2_rel_error=e["uy_l2"],
+                   syy_ahead_l2_rel_error=e["syy_l2_far"], elastic_wall_time_s=e["wall"],
+                   elastic_particles=e["particles"], elastic_steps=e["steps"], elastic_time_s=e["t"],
+                   elastic_final_kinetic_energy_J=e["ke"])
+    print(f"elastic l={a.spacing}: u_y centre error {e['uy_centre_err']:+.4f}, L2 {e['uy_l2']:.4f}, "
+          f"σyy L2 (2 cells..1 m ahead) {e['syy_l2_far']:.4f}, wall {e['wall']:.1f} s", flush=True)
+    return e
+
+
+def convergence_part(a, parts, e, stopped, summary):
+    """The elastic run at each --conv-spacings (the elastic part's run reused at its spacing): error against wall time."""
+    conv = []
+    for h in [float(v) for v in a.conv_spacings.split(",")]:
+        same = "elastic" in parts and abs(h - a.spacing) < 1e-12
+        c = e if same else attempt(stopped, f"convergence l={h:g}", run_elastic, a.size, h, a.elastic_pressure, a)
+        if c is None:
+            continue
+        conv.append(c)
+        write_uy(os.path.join(a.out, f"elastic_uy_l{h:g}.csv"), c)
+        print(f"convergence l={h}: centre {c['uy_centre_err']:+.4f}, L2 {c['uy_l2']:.4f}, wall {c['wall']:.1f} s", flush=True)
+    out.write_csv(os.path.join(a.out, "error_vs_walltime.csv"),
+                  ["spacing_m", "particles", "steps", "wall_s", "uy_center_rel_error", "uy_l2_rel_error", "syy_ahead_l2_rel_error"],
+                  [(c["h"], c["particles"], c["steps"], c["wall"], c["uy_centre_err"], c["uy_l2"], c["syy_l2_far"]) for c in conv])
+    if conv:
+        line_crack_figures.plot_convergence(conv, a.out)
+    summary["convergence"] = [dict(spacing_m=c["h"], particles=c["particles"], wall_time_s=c["wall"],
+                                   uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
+
+
+def damage_part(a, stopped, summary):
+    """The damage run of each growth law in --laws: crack extension against the paper's Fig. 9; the first law's
+    numbers also at the top level of the summary. Returns the runs."""
     results = []
-    if "damage" in parts:
-        for law in a.laws.split(","):
-            r = attempt(f"damage {law}", run_damage, a, law, a.out)
-            if r is None:
-                continue
-            results.append(r)
-            particles = max(particles, r["particles"])
-            table = [dict(t_s=t, left=interp_da(r["rows"], t)[0], right=interp_da(r["rows"], t)[1])
-                     for t in [0.05, 0.1, 0.2, 0.3, 0.4] if t <= a.end_time + 1e-9]
-            summary[f"damage_{law}"] = dict(crack_extension_cells=table, plastic_particles=r["plastic"],
-                                               plastic_particles_not_cracked=r["plastic_intact"],
-                                               wall_time_s=r["wall"], steps=r["steps"], ramp_time_s=r["ramp"],
-                                               spacing_m=r["h"], particles=r["particles"])
-            if a.end_time >= PAPER_DA[-1][0] - 1e-9:
-                summary[f"damage_{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
-            print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
-                  + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
-    if "damage" in parts and results:
-        plot_da(results, a.out)
+    for law in a.laws.split(","):
+        r = attempt(stopped, f"damage {law}", run_damage, a, law, a.out)
+        if r is None:
+            continue
+        results.append(r)
+        table = [dict(t_s=t, left=interp_da(r["rows"], t)[0], right=interp_da(r["rows"], t)[1])
+                 for t in [0.05, 0.1, 0.2, 0.3, 0.4] if t <= a.end_time + 1e-9]
+        summary[f"damage_{law}"] = dict(crack_extension_cells=table, plastic_particles=r["plastic"],
+                                        plastic_particles_not_cracked=r["plastic_intact"],
+                                        wall_time_s=r["wall"], steps=r["steps"], ramp_time_s=r["ramp"],
+                                        spacing_m=r["h"], particles=r["particles"])
+        if a.end_time >= PAPER_DA[-1][0] - 1e-9:
+            summary[f"damage_{law}"]["paper_comparison"] = paper_comparison(r["rows"], r["h"])
+        print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
+              + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
+    if results:
+        line_crack_figures.plot_da(results, a.out)
         first = summary[f"damage_{results[0]['law']}"]
         summary["default_law"] = results[0]["law"]
         summary["crack_extension_cells"] = first["crack_extension_cells"]
@@ -403,11 +309,12 @@ def main(argv=None):
         if "paper_comparison" in first:
             summary["paper_comparison"] = first["paper_comparison"]
         summary["paper_crack_extension_cells"] = [dict(t_s=t, cells=n) for t, n in PAPER_DA]
-    summary["stopped"] = stopped
-    summary["wall_time_s"] = time.time() - wall0
-    summary["particles"] = particles
-    summary["parts_run"] = sorted(parts)
-    old = os.path.join(a.out, "summary.json")
+    return results
+
+
+def merged_with_earlier_parts(outdir, summary, parts, particles):
+    """summary, merged with the summary.json of parts run separately into the same directory (their keys kept)."""
+    old = os.path.join(outdir, "summary.json")
     if os.path.exists(old):            # parts run separately into one directory: keep the others' keys
         import json
         with open(old) as f:
@@ -421,6 +328,31 @@ def main(argv=None):
             merged["wall_time_s"] = summary["wall_time_s"] + prev.get("wall_time_s", 0.0)
             merged["particles"] = max(particles, prev.get("particles", 0))
             summary = merged
+    return summary
+
+
+def main(argv=None):
+    global HALF_CRACK, COURANT
+    a, parts, COURANT = parse_options(argv)
+    HALF_CRACK = a.half_length            # every analysis below reads the crack half-length from here
+    if a.full:
+        a.spacing = 0.02
+    if a.threads > 0:
+        ym.setThreads(a.threads)
+    os.makedirs(a.out, exist_ok=True)
+    summary = dict(config=run_config(a))
+    wall0 = time.time()
+    stopped = []                        # runs the solver stopped: named with the message, the other runs still run
+    e = elastic_part(a, stopped, summary) if "elastic" in parts else None
+    if "convergence" in parts:
+        convergence_part(a, parts, e, stopped, summary)
+    results = damage_part(a, stopped, summary) if "damage" in parts else []
+    particles = max([0] + [r["particles"] for r in ([e] if e is not None else []) + results])
+    summary["stopped"] = stopped
+    summary["wall_time_s"] = time.time() - wall0
+    summary["particles"] = particles
+    summary["parts_run"] = sorted(parts)
+    summary = merged_with_earlier_parts(a.out, summary, parts, particles)
     out.write_summary(a.out, summary)
     batch.write_summary(a.out, [study_row(a, parts, summary)])
     if stopped:

@@ -1,0 +1,6 @@
+"""The validation report, doc/validation.md (scripts/paper/report.py is its command line):
+
+    document           the folders read, the Markdown being written, figures, tables, notes
+    sections           the reproduced cases: benchmarks, circular opening, line crack, stability, uniaxial, tunnel
+    fidelity_sections  the fidelity table, the one-at-a-time variants and the time-step study
+"""
