@@ -1,9 +1,9 @@
-"""Builds doc/validation.md from the output folders of the reference scripts: every case's figures
+"""Builds doc/validation/report.md from the output folders of the reference scripts: every case's figures
 (copied to doc/figures/) and numbers, error against run time for the benchmarks, the stability table,
 the uniaxial sweeps, the fidelity table (every claim of the paper about its results, measured; yade_mpm_paper.fidelity.table) and the
 one-at-a-time variants behind it (scripts/paper/fidelity_variants.py).
 
-    /usr/bin/python3 scripts/paper/report.py                       # reads out/<case>/, writes doc/validation.md
+    /usr/bin/python3 scripts/paper/report.py                       # reads out/<case>/, writes doc/validation/report.md
     /usr/bin/python3 scripts/paper/report.py --root out --doc doc
 
 Folders read (each optional; a missing one is reported with the command that makes it):
@@ -59,6 +59,7 @@ class Report:
     def __init__(self, root, doc, dirs=None):
         self.root, self.doc, self.dirs = root, doc, dict(dirs or {})
         self.fig_dir = os.path.join(doc, "figures")
+        self.path = os.path.join(doc, "validation", "report.md")
         os.makedirs(self.fig_dir, exist_ok=True)
         self.lines = []
 
@@ -88,7 +89,7 @@ class Report:
             return False
         dst = os.path.join(self.fig_dir, name)
         shutil.copyfile(src, dst)
-        rel = os.path.relpath(dst, self.doc)
+        rel = os.path.relpath(dst, os.path.dirname(self.path))
         self.w(f"![{caption}]({rel})" if width is None else f'<img src="{rel}" width="{width}" alt="{caption}">', f"*{caption}*", "")
         return True
 
@@ -100,10 +101,10 @@ class Report:
                     self.figure(p, f"{part}_{os.path.basename(p)}", f"{part}: {os.path.basename(p)}")
 
     def write(self):
-        path = os.path.join(self.doc, "validation.md")
-        with open(path, "w") as f:
+        os.makedirs(os.path.dirname(self.path), exist_ok=True)
+        with open(self.path, "w") as f:
             f.write("\n".join(self.lines).rstrip() + "\n")
-        return path
+        return self.path
 
 
 def fmt(v, nd=3):
@@ -374,24 +375,24 @@ def variant_matrix(R, folder="fidelity_variants"):
     R.w("## Causes: one-at-a-time variants of the modelling choices", "")
     if not files:
         R.w(f"*Not run here* — `/usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial|tunnel ...` writes `{shown(os.path.join(R.root, folder))}/`.", "")
-        if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
+        if os.path.exists(os.path.join(REPO, "archive", "fidelity_variants_d734961.md")):
             R.w("The last screening matrix (build before issue 17's contact fix, C = 0.5) is kept verbatim in "
-                "[fidelity_variants_d734961.md](fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
+                "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
         return
     runs = [json.load(open(f)) for f in files]
-    if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
+    if os.path.exists(os.path.join(REPO, "archive", "fidelity_variants_d734961.md")):
         done = {(r["scene"], r["variant"]) for r in runs}
         old = [n for v, n in (("as_printed_growth", "uniaxial growth law"), ("v_cube", "V = dp³"), ("no_residual_cohesion", "residual cohesion"),
                               ("soft_strain_0.01", "ε̄p,crit = 0.01")) if ("uniaxial", v) not in done] + ["tunnel intact at 2.5 mm"]
         R.w(f"Variants not in the matrix below ({', '.join(old)}) were screened on an older build (before issue 17's contact fix): "
-            "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
-    if os.path.exists(os.path.join(REPO, "doc", OLD_INCREMENT)):
+            "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md), kept verbatim.", "")
+    if os.path.exists(os.path.join(REPO, "archive", OLD_INCREMENT)):
         done = {r["variant"] for r in runs if r["scene"] == "tunnel"}
         old = [n for v, n in (("principal_strain", "Eq. 36 as the principal strain"), ("floor_52.5mm", "the opening centred"),
                               ("flaw_gap_5mm", "the flaw toe 5 mm from the wall")) if v not in done]
         if old:
             R.w("Tunnel variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) "
-                f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}).", "")
+                f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}](../../archive/{OLD_INCREMENT}).", "")
     include_notes(R, os.path.join(R.root, folder, "notes.md"))
     from yade_mpm_paper import fidelity
     for scene, case in sorted({(r["scene"], r["case"]) for r in runs}):
@@ -459,9 +460,9 @@ FROZEN = "paper_grid_and_courant_7ac11e5.md"      # the last paper-grid tunnel r
 
 
 def frozen(R):
-    """Link the frozen record of sections whose outputs are not here (doc/FROZEN)."""
-    if os.path.exists(os.path.join(REPO, "doc", FROZEN)):
-        R.w(f"The last runs of this section (main `7ac11e5`, simulation code of `d734961`) are kept verbatim in [{FROZEN}]({FROZEN}).", "")
+    """Link the frozen record of sections whose outputs are not here (archive/FROZEN)."""
+    if os.path.exists(os.path.join(REPO, "archive", FROZEN)):
+        R.w(f"The last runs of this section (main `7ac11e5`, simulation code of `d734961`) are kept verbatim in [{FROZEN}](../../archive/{FROZEN}).", "")
 
 
 def _ms(t):
@@ -471,7 +472,7 @@ def _ms(t):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--root", default="out", help="folder holding the output folders (default out)")
-    ap.add_argument("--doc", default="doc", help="doc folder (default doc): writes validation.md and figures/")
+    ap.add_argument("--doc", default="doc", help="doc folder (default doc): writes validation/report.md and figures/")
     ap.add_argument("--dir", action="append", default=[], metavar="PART=DIR",
                     help=f"read PART from DIR instead of ROOT/PART (PART: {', '.join(PARTS)}); repeatable")
     a = ap.parse_args()

@@ -1,6 +1,6 @@
 """The stability suite: small scenes that push the explicit WLS-MPM step to its limits, and the checked
 run that watches every step (scripts/paper/stability.py is its command line, tests/test_stability.py runs the
-coarse versions; doc/stability.md has the results).
+coarse versions; doc/validation/stability.md has the results).
 
 Cases: stiff (E = 200 GPa), nearly incompressible (ν = 0.49), very soft (E = 1 MPa), traction ramped
 at a baseline quasi-static rate and 100× faster, a column collapsing under gravity (large plastic
