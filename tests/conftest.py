@@ -6,7 +6,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
 
 import pytest  # noqa: E402
 
-# Markers by file (tests/README.md): `-m quick` is the daily subset (< 2 minutes on 2 cores); the README's
+# Markers by file (doc/developer/testing.md): `-m quick` is the daily subset (< 2 minutes on 2 cores); the README's
 # test command runs everything. A file's tests carry its topic marker; `slow` marks the tests that take longest.
 TOPICS = {
     "unit": ["test_analysis", "test_bad_input", "test_entrance_errors", "test_fields", "test_layout", "test_params",
