@@ -254,7 +254,7 @@ struct ContactWrap {
 		        .def("setRigidPartMass", &setRigidPartMass, (bp::arg("part"), bp::arg("mass"), bp::arg("inertia")),
 		             "mass [kg] (2D: kg/m) and principal moments of inertia about the centre along the part's axes [kg m^2] (2D: I_z, "
 		             "kg m^2/m) of a part, each in (0, inf]; inf (the default) = immovable along it (the paper's stick step). For a free "
-		             "part every contact node sticks to the part's motion after the step, from its momentum balance (doc/contact.md)")
+		             "part every contact node sticks to the part's motion after the step, from its momentum balance (doc/reference/contact.md)")
 		        .def("rigidPartMass", &rigidPartMass, bp::arg("part"), "(mass, inertia) of a part as set by setRigidPartMass")
 		        .def("setRigidPartMasses", &setRigidPartMasses, (bp::arg("parts"), bp::arg("mass"), bp::arg("inertia")),
 		             "masses (n,) and principal moments of inertia (n, 1|3) of many parts, as setRigidPartMass")

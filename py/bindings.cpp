@@ -26,7 +26,7 @@ int getThreads() { return omp_get_max_threads(); }
 } // namespace
 
 #ifdef MPM_MPI
-#define MPM_MODULE _core_mpi // the MPI build of the same sources (doc/scaling.md)
+#define MPM_MODULE _core_mpi // the MPI build of the same sources (doc/developer/scaling.md)
 #else
 #define MPM_MODULE _core
 #endif

@@ -21,10 +21,10 @@ results stay within these tolerances of the numbers a reference build stored:
     ... --courant C     every case at the Courant number C (a Δt study; the reference is at the solver's default)
 
 Re-recorded (not a tolerance miss): tunnel and uniaxial on main 90d5a68, issue 18's modelling change of the ε̄p
-increment (DpGkMat.plasticStrainIncrement = 'reference-code', doc/damage_growth_law.md): uniaxial peaks intact
+increment (DpGkMat.plasticStrainIncrement = 'reference-code', doc/reference/damage_growth_law.md): uniaxial peaks intact
 95.497 → 95.401, open 37.208 → 36.151, filled μ_con = 0.4 45.104 → 44.487 MPa; tunnel σ at 2 mm 202.889 → 202.449 MPa
 (within tolerance; first crack unchanged). Kirsch and Sneddon (elastic) passed unchanged and were not re-recorded.
-Re-recorded again for the kinematic contact law becoming the default (ContactParams.law, doc/contact.md "Contact
+Re-recorded again for the kinematic contact law becoming the default (ContactParams.law, doc/reference/contact.md "Contact
 laws"; the penalty law of Eq. 23 stays as law='penalty'): uniaxial peaks intact 95.401 → 95.657 (+0.27 %), open
 36.151 → 37.117 (+2.7 %), filled μ_con = 0.4 44.487 → 46.929 MPa (+5.5 %); tunnel σ at 0.5 / 1 / 2 mm 52.189 → 52.474,
 104.560 → 105.141, 202.449 → 203.354 MPa (+0.55, +0.56, +0.45 %); first crack time −0.22 %, same place (floor, x 75,

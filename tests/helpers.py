@@ -44,3 +44,9 @@ def script_path(name):
     found = sorted(glob.glob(os.path.join(ROOT, "scripts", "**", name), recursive=True) + glob.glob(os.path.join(ROOT, "examples", name)))
     assert len(found) == 1, f"script {name!r}: {found}"
     return found[0]
+
+
+def pythonpath():
+    """PYTHONPATH for a child process that must import this checkout's packages."""
+    import os
+    return os.pathsep.join([os.path.join(ROOT, "py")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])

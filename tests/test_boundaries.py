@@ -1,4 +1,4 @@
-"""Exact boundaries (doc/boundaries.md): slip planes are symmetry planes (reflected images), fixed planes
+"""Exact boundaries (doc/reference/boundaries.md): slip planes are symmetry planes (reflected images), fixed planes
 act where they are placed (one-sided WLS), thin gaps do not tie their faces through shared nodes."""
 import numpy as np
 import pytest

@@ -7,7 +7,7 @@
   the box's spin taken up by the block (it cannot turn through the slot's faces);
 - the tunnel's platen corner at C = 1 (the paper's time-step bound), where the corner particle inverted before
   issue 17's positive lumping: it runs, and the platen reaction stays that of C = 0.5 within the penalty's
-  compliance (doc/contact.md).
+  compliance (doc/reference/contact.md).
 """
 import math
 
@@ -126,7 +126,7 @@ def test_free_box_turning_in_a_slot():
 @pytest.mark.parametrize("case", ["tunnel", "uniaxial"])
 def test_platen_corner_at_courant_1(case):
     """The 2 mm tunnel (intact) and uniaxial (open flaw) scenes at C = 1, the paper's time-step bound, 300 steps (the
-    uniaxial platen corner inverted at step 31 before issue 17's positive lumping, doc/fidelity_variants_d734961.md): the
+    uniaxial platen corner inverted at step 31 before issue 17's positive lumping, archive/fidelity_variants_d734961.md): the
     run does not stop, and the particles under the platen (top 2 particle rows, their stencils cut by the platen and the
     free-slip side planes) keep a smooth volume: every J = V/V0 within 1e-3 of 1 (measured 0.99988–0.99991 at the
     platen's 28 µm; a corner mode shows as a spread)."""

@@ -1,6 +1,6 @@
 """Contact detection distance d0 = "initial" (paper, text after Eq. 26: d0 is the particle's initial
 distance to the surface): the first lattice layer of particles next to a body at registration touches it
-at zero force from t = 0 (doc/contact.md). Checked: the first-layer rule picks exactly one particle per
+at zero force from t = 0 (doc/reference/contact.md). Checked: the first-layer rule picks exactly one particle per
 lattice line along an inclined straight face; one step's penalty force on a pushed slab equals
 N (1 − χ) 2m δ/Δt² (Eq. 23) exactly; a rigid slab in a cut across a column carries the load from the start
 with the column's stiffness, where the default d0 leaves it unloaded until the gap closes; bad input."""

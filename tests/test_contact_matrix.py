@@ -165,7 +165,7 @@ def test_block_on_rotating_plate_follows_it(omega):
     assert turned / angle == pytest.approx(1.0, abs=0.005)
     # `vel` is the velocity of the material point (fields.py), the quantity of the bar: 5 % at every recorded step for
     # every particle (measured worst 0.042, 0.031, 0.032, 0.031 for ω = 1, −1, 2, −2). With the Shepard lumping alone it
-    # failed at ω = ±1 (0.42, 1.70 at a bottom corner: a light node beside the corner with a large ψ_i, doc/contact.md).
+    # failed at ω = ±1 (0.42, 1.70 at a bottom corner: a light node beside the corner with a large ψ_i, doc/reference/contact.md).
     assert E.max() <= 0.05
 
 

@@ -1,5 +1,5 @@
 """Contact parameters declared once (pkg-mpm/ContactParams.hpp, issue 20): every Python-visible contact
-attribute documents its unit and range, the ends of each range are enforced, doc/contact.md holds the
+attribute documents its unit and range, the ends of each range are enforced, doc/reference/contact.md holds the
 generated table, RigidBodies.add and DemSpheres.add take the same keywords, a body registered without mu
 takes tan(frictionAngle) of its YADE FrictMat (incline against g(sin θ − μ cos θ)), and the bad inputs of
 issue 20 are refused (or, NumPy scalars, accepted) before any work."""
@@ -56,7 +56,7 @@ def test_contact_ranges_are_enforced_at_the_ends_and_round_trip():
 
 
 def test_doc_contact_md_holds_the_generated_table():
-    with open(os.path.join(ROOT, "doc", "contact.md"), encoding="utf-8") as f:
+    with open(os.path.join(ROOT, "doc", "reference", "contact.md"), encoding="utf-8") as f:
         assert ym.materials.markdown_table(ym.ContactParams) in f.read()
 
 

@@ -1,4 +1,4 @@
-"""Stick step of a free body (paper Eq. 24 with the body's mass; PtsContact::bodyResponse, doc/contact.md):
+"""Stick step of a free body (paper Eq. 24 with the body's mass; PtsContact::bodyResponse, doc/reference/contact.md):
 every contact node sticks to the body's motion after the step, f_stick,j = −m_j P_j (ṽ_j − J_j Δq)/Δt, with Δq
 the body's response to the reactions; for a uniform slip along a face with the rotation prescribed this is
 the reduced mass, −m_j ṽ_tan M/(M + S)/Δt (S = Σ_j m_j over the contact nodes); an immovable body keeps the

@@ -40,7 +40,7 @@ def test_threshold_volume_readings_give_eq37(spacing):
         assert eps0 == pytest.approx(np.full(s.numParticles, eq37(V)), rel=1e-12), reading
     # the readings differ by fixed factors: dp³ raises ε_D⁰ by (1 m/dp)^(1/m) over area × 1 m
     assert eq37(dp ** 3) / eq37(dp * dp) == pytest.approx((1.0 / dp) ** (1 / M_W), rel=1e-12)
-    # paper grid (l = 0.02 m), literal reading: ε_D⁰ = 4.54e-4 (doc/damage_growth_law.md)
+    # paper grid (l = 0.02 m), literal reading: ε_D⁰ = 4.54e-4 (doc/reference/damage_growth_law.md)
     if spacing == 0.02:
         assert eq37(dp * dp) == pytest.approx(4.540e-4, rel=1e-3)
 

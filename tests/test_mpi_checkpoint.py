@@ -1,4 +1,4 @@
-"""Checkpoints on N MPI ranks (py/yade_mpm/checkpoint_mpi.py, doc/scaling.md "Checkpoints"): a 2D elastic
+"""Checkpoints on N MPI ranks (py/yade_mpm/checkpoint_mpi.py, doc/developer/scaling.md "Checkpoints"): a 2D elastic
 block is saved on 2 ranks after 20 steps (a piece per rank and an index) and stepped 20 more, in which
 particles migrate between the ranks; a second 2-rank run builds the scene afresh, loads the checkpoint and
 steps 20: every

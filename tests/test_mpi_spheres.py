@@ -1,4 +1,4 @@
-"""DEM spheres under MPI (py/yade_mpm/spheres.py, doc/scaling.md "Rigid bodies"): every rank runs the same
+"""DEM spheres under MPI (py/yade_mpm/spheres.py, doc/developer/scaling.md "Rigid bodies"): every rank runs the same
 YADE scene; the broad phase of ``DemSpheres`` reads the particle box of every rank (one max-reduction of 2D
 doubles per check) and the global max ‖v‖, so all ranks enable the same contact groups at the same steps
 and meet in the same collectives (with the rank's own box a 2-rank run hung). A 2D elastic block with a

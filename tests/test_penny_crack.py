@@ -1,6 +1,6 @@
 """Pressurised line crack (paper Sec. 3.2) on reduced set-ups that run in seconds: the elastic opening
 against Sneddon (Eq. 43) and the stress ahead of the tip against Eq. 44; crack growth from both tips
-with the DP–GK rock. The full-size numbers come from scripts/paper/penny_crack.py (doc/penny_crack.md)."""
+with the DP–GK rock. The full-size numbers come from scripts/paper/penny_crack.py (doc/validation/penny_crack.md)."""
 import json
 import math
 import os

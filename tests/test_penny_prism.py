@@ -1,4 +1,4 @@
-"""The 3D-only case of doc/three_d.md (``cases.prism3d``): the disc flaw's geometry against its analytical
+"""The 3D-only case of doc/validation/three_d.md (``cases.prism3d``): the disc flaw's geometry against its analytical
 volume and frame, and the prism's symmetric models (slip planes through its centre) against the whole
 prism: the same platen stress to roundoff for the intact prism on a coarse grid."""
 import math
@@ -36,7 +36,7 @@ def test_symmetric_models_match_the_whole_prism(h, steps, models, law, rtol):
     # layer come from an iterative solve (projected Gauss–Seidel to 1e-6 of the contact speed) whose sweep order
     # differs between the models: measured 8.8e-5 (z, 4 mm).
     # the quarter (xz) is checked on the run's grid, 2.5 mm: on a 4 mm grid (5 cells between its plane and the free
-    # face) it differs from the whole prism by 2 % from the second step (doc/three_d.md, not understood)
+    # face) it differs from the whole prism by 2 % from the second step (doc/validation/three_d.md, not understood)
     from yade import O
     rec = {}
     for sym in ("none",) + models:

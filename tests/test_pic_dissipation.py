@@ -1,5 +1,5 @@
 """The particle velocity update of Eq. 6 (v_p = Σ ψ_i v_i) loses a fixed share of a standing elastic wave's energy per
-step, not per unit time (scripts/paper/pic_dissipation.py, doc/algorithm.md "The particle velocity update and C"): over the
+step, not per unit time (scripts/paper/pic_dissipation.py, doc/reference/algorithm.md "The particle velocity update and C"): over the
 same 100 µs, C = 0.5 takes twice the steps of C = 1 and keeps the square of its share (measured 0.9568 and 0.9161,
 0.9568² = 0.9155). A change of the transfer that alters this shows here."""
 import importlib.util

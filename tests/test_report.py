@@ -1,4 +1,4 @@
-"""scripts/paper/report.py names folders relative to the repository: the generated doc/validation.md holds no
+"""scripts/paper/report.py names folders relative to the repository: the generated doc/validation/report.md holds no
 absolute path of the machine it was made on (also for output folders elsewhere)."""
 import os
 import re
@@ -17,13 +17,13 @@ def test_generated_report_names_no_absolute_path(tmp_path):
     r = subprocess.run([sys.executable, script_path("report.py"), "--root", str(out), "--doc", str(tmp_path / "doc"),
                         "--dir", f"penny_crack_damage={tmp_path / 'crack_runs' / 'c02'}"], capture_output=True, text=True, env=env, timeout=120)
     assert r.returncode == 0, r.stderr[-2000:]
-    text = (tmp_path / "doc" / "validation.md").read_text()
+    text = (tmp_path / "doc" / "validation" / "report.md").read_text()
     assert str(tmp_path) not in text and not ABSOLUTE.search(text), ABSOLUTE.search(text)
     assert "…/elsewhere/out (outside the repository)" in text
 
 
 def test_validation_md_has_no_absolute_path():
-    text = open(os.path.join(ROOT, "doc", "validation.md")).read()
+    text = open(os.path.join(ROOT, "doc", "validation", "report.md")).read()
     hit = ABSOLUTE.search(text) or (os.path.dirname(ROOT) + "/" in text)
     assert not hit, hit
 
@@ -57,6 +57,6 @@ def test_baseline_from_a_tunnel_run_and_the_variant_matrix(tmp_path):
     assert j["snapshots"]["20ms"]["eps_p_soft_end"] == 0.9 * 0.1 and j["first_crack"] == dict(time_s=2.1e-4, at="flaw toe")
     r = run(script_path("report.py"), "--root", "out", "--doc", "doc")
     assert r.returncode == 0, r.stderr[-2000:]
-    text = (tmp_path / "doc" / "validation.md").read_text()
+    text = (tmp_path / "doc" / "validation" / "report.md").read_text()
     row = next(line for line in text.splitlines() if line.startswith("| baseline"))
     assert "| 9.5, left wall |" in row and "| 80 / 11 / 7 |" in row and "0.04 / 0.04 (0.09)" in row

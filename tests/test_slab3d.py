@@ -1,5 +1,5 @@
 """The uniaxial flaw specimen as a 3D slab between slip planes (``cases.uniaxial_flaw(slab_cells=n)``,
-doc/three_d.md) against the 2D plane-strain run of the same builder: with a fixed platen detection
+doc/validation/three_d.md) against the 2D plane-strain run of the same builder: with a fixed platen detection
 distance every z layer of the slab moves as the 2D particles to roundoff (the slip planes impose plane
 strain exactly); with the default d0 (half the current particle edge, ½V^(1/D), not the same in 2D and
 3D) the elastic modulus and the curve agree within the issue's 2 % (measured ~0.1 %)."""

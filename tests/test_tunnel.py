@@ -63,7 +63,7 @@ def test_platen_impact_stress_and_symmetry():
     assert np.mean(sig) == pytest.approx(rho_c_v, rel=0.01)
     # Since the positive lumping at cut stencils (issue 17) the platen reaction rings for ~5 µs after the
     # first contact: up to 6.2 % at 11–16 µs and 2.0 % at 16 µs (before: 2 % from 11 µs on), after 20 µs within 0.3 %.
-    # (Cut-stencil lumping η with ψ⁺, doc/algorithm.md: after 20 µs 0.67 % measured; with |ψ| instead of ψ⁺ it was 1.6 %.)
+    # (Cut-stencil lumping η with ψ⁺, doc/reference/algorithm.md: after 20 µs 0.67 % measured; with |ψ| instead of ψ⁺ it was 1.6 %.)
     assert np.max(dev[np.array(t) > 20e-6]) < 0.01
     assert np.max(dev) < 0.07
     lat = analysis.Lattice(ym.get(s, "pos"), L / 2, origin=(0, 0))

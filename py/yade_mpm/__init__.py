@@ -14,7 +14,7 @@ _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 from . import _guards
 _guards.cap_omp_threads()   # before libgomp reads OMP_NUM_THREADS (loaded with _core)
 from . import parallel
-_core = parallel.load_core(__name__)   # the serial core, or under mpirun the MPI build (doc/scaling.md)
+_core = parallel.load_core(__name__)   # the serial core, or under mpirun the MPI build (doc/developer/scaling.md)
 from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, ContactParams
 from . import _core
 _guards.install(_core)      # Solver.view("id") read-only, Solver.reserve(n) checked against the memory

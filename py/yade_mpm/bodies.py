@@ -1,5 +1,5 @@
 """Rigid YADE bodies in an MPM scene: the adapter between ``O.bodies``/``O.forces`` and the core's PTS
-contact (paper Sec. 2.3, Eqs. 23–26; the algorithm is in pkg-mpm/PtsContact.hpp, see doc/contact.md).
+contact (paper Sec. 2.3, Eqs. 23–26; the algorithm is in pkg-mpm/PtsContact.hpp, see doc/reference/contact.md).
 
     rb = ym.RigidBodies(solver)
     rb.add(platen_id, mu=0.0)                       # one contact group per call, its own μ, c, χ, d0
@@ -11,7 +11,7 @@ registered body from ``O.bodies`` into the solver) before the MPM step and ``wri
 reaction force and its torque about the body's centre, ``state.pos``, added to ``O.forces``) after it,
 so NewtonIntegrator moves free bodies and bodies with ``blockedDOFs`` and a set velocity keep it.
 ``read()`` also passes each body's mass and inertia (``body_inertia``): the stick step of the friction
-(Eq. 24) moves a free body with its contact nodes, so a light body does not overshoot (doc/contact.md).
+(Eq. 24) moves a free body with its contact nodes, so a light body does not overshoot (doc/reference/contact.md).
 
 Shapes: ``Box`` (oriented), ``Wall`` (``sense`` +1 / −1: the material is on the +axis / −axis side and
 the wall is a half-space; ``sense`` 0: a two-sided plane), ``Facet`` (a triangle; facets of one ``add``
@@ -30,7 +30,7 @@ per metre of the plane-strain slice: its dynamics match the MPM side for any t. 
 Contact parameters: the keywords ``law``, ``mu``, ``cohesion``, ``chi``, ``d0`` of ``add`` (the same for
 ``DemSpheres.add``) make one ``ym.ContactParams``, whose parameters are declared once, with unit, range,
 default and equation, in pkg-mpm/ContactParams.hpp (``print(ym.materials.describe(ym.ContactParams))``;
-table in doc/contact.md). Every keyword is checked before any work; NumPy scalars are numbers.
+table in doc/reference/contact.md). Every keyword is checked before any work; NumPy scalars are numbers.
   mu        friction coefficient μ_con [-]. Not given: tan(frictionAngle) of the bodies' YADE ``FrictMat``
             (``b.material``; a clump: its members'), the friction a YADE user sets on the body; explicit
             values win; bodies of one ``add`` with different friction angles need an explicit mu; a
@@ -42,7 +42,7 @@ table in doc/contact.md). Every keyword is checked before any work; NumPy scalar
             centre (ValueError).
   law       "kinematic" (default): no-penetration impulses at the contacting particles, results independent of
             Δt; "penalty": the paper's Eq. 23 as printed (κ = 2m/Δt²; chi applies to it only)
-            (doc/contact.md, "Contact laws").
+            (doc/reference/contact.md, "Contact laws").
   cohesion, chi: given or the declared defaults.
 """
 import math

@@ -40,7 +40,7 @@ def write_pvtu(path, pieces, point_data):
 
 def write_particle_file(stem, points, data):
     """STEM.vtu, or under MPI (N > 1 ranks) this rank's piece STEM.rK.vtu and, from rank 0, the index
-    STEM.pvtu of all N pieces (doc/scaling.md). Returns the path to open (.vtu or .pvtu)."""
+    STEM.pvtu of all N pieces (doc/developer/scaling.md). Returns the path to open (.vtu or .pvtu)."""
     from .parallel import rank, size
     if size() == 1:
         write_vtu(stem + ".vtu", points, data)

@@ -1,4 +1,4 @@
-"""MPI domain decomposition (doc/scaling.md): which compiled core ``import yade_mpm`` loads, and this
+"""MPI domain decomposition (doc/developer/scaling.md): which compiled core ``import yade_mpm`` loads, and this
 process's rank.
 
 The serial module ``yade_mpm._core`` is what ``import yade_mpm`` loads by default. The MPI build of the

@@ -16,7 +16,7 @@ and its moment about the body's centre) goes to ``O.forces`` after the MPM step,
 the MPM grid nodes, so NewtonIntegrator moves the spheres; sphere–sphere contacts stay with YADE's
 collider and interaction loop. Each active body's mass and inertia (``bodies.body_inertia``; 3D: the
 smallest principal moment on every axis) go to the solver every step: the stick step of the friction
-moves a free sphere with its contact nodes (doc/contact.md).
+moves a free sphere with its contact nodes (doc/reference/contact.md).
 
 Broad phase (far spheres cost almost nothing): a body is *active* (its group enabled, its state sent
 to the solver, its reaction read back) only while its bounding circle/sphere comes within ``reach``
@@ -27,7 +27,7 @@ at its current speed and with the gravity acceleration of NewtonIntegrator, to c
 smallest gap — at most ``max_check_steps`` steps later. Between checks a step costs one disabled-flag
 test per far body in C++ and nothing in Python.
 
-MPI (``mpirun``, doc/scaling.md "Rigid bodies"): every rank runs the same YADE scene and takes the same
+MPI (``mpirun``, doc/developer/scaling.md "Rigid bodies"): every rank runs the same YADE scene and takes the same
 broad-phase decisions — the particle box is the box of every rank's particles (one max-reduction of 2d
 doubles per check, ``_core.mpiMax``; a rank without particles takes part) and ``Solver.maxSpeed`` is the
 global one — so the ranks enable the same groups at the same steps and meet in the same collectives of

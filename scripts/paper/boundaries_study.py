@@ -1,4 +1,4 @@
-"""Exact boundaries (doc/boundaries.md, issue 8): the numbers and figures of the boundary study.
+"""Exact boundaries (doc/reference/boundaries.md, issue 8): the numbers and figures of the boundary study.
 
   slip     uniform σ on one plane, each side, 2D and 3D: 'slip' (reflected images) vs 'slip-onesided'
   bar      fixed–free bar period vs 4L/c at L/l = 20, 40, 80 ('fixed' = one-sided WLS on a node line)

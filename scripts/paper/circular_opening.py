@@ -18,12 +18,12 @@ errors ‖σ_MPM − σ_K‖/‖σ_K‖ over the particles of a line with r ≥ 
 boundary rows included). Hoop stress at the wall (θ = 0°: σyy on y = 2.5 m, θ = 90°: σxx on
 x = 2.5 m): straight-line extrapolation to r = a of the rows within one cell of the wall; the
 nearest-row mean is reported too. Default: L = 4.8 m, l = 0.04 m, convergence table l = 0.08, 0.06,
-0.04 m (doc/circular_opening.md). A run of the ladder that the solver stops is named under "stopped" in
+0.04 m (doc/validation/circular_opening.md). A run of the ladder that the solver stops is named under "stopped" in
 summary.json (with its message) and the others still run; the exit status is then 1.
 
     /usr/bin/python3 scripts/paper/circular_opening.py --out out/circular_opening             # default
     /usr/bin/python3 scripts/paper/circular_opening.py --out out/co_paper --spacing 0.01 --domain 5 --no-convergence
-    yade-batch scripts/paper/circular_opening.table scripts/paper/circular_opening.py   # a study: one run per line (doc/studies.md)
+    yade-batch scripts/paper/circular_opening.table scripts/paper/circular_opening.py   # a study: one run per line (doc/guide/studies.md)
 """
 import argparse
 import math

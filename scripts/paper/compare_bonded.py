@@ -28,7 +28,7 @@ particles, wall_time_s, cpu_time_s, ...}}, kirsch: [{method, wall_time_s, cpu_ti
 ...}], calibration}), calibration.csv, curves_*.csv, stress_strain.png, cracks_intact.png,
 cracks_open_flaw.png, kirsch_error_vs_time.png/.csv. An MPM run the solver stops keeps its curve up to the stop
 (end_reason "error" and the message in summary.json); every part still runs, the stopped runs are listed under
-"stopped" and the exit status is 1. Results and discussion: doc/mpm_vs_bonded.md.
+"stopped" and the exit status is 1. Results and discussion: doc/validation/mpm_vs_bonded.md.
 
     PYTHONPATH=py OMP_NUM_THREADS=1 /usr/bin/python3 scripts/paper/compare_bonded.py --out out/compare_bonded
     ... --parts kirsch          # one part only (uniaxial, kirsch)
@@ -54,7 +54,7 @@ from yade_mpm import output as out
 
 MPa, GPa = 1e6, 1e9
 SAND = rocks.MIAO2018_SANDSTONE
-# JCFpm choices kept fixed during the calibration (documented in doc/mpm_vs_bonded.md)
+# JCFpm choices kept fixed during the calibration (documented in doc/validation/mpm_vs_bonded.md)
 KS_KN = 0.3              # ks/kn (JCFpmMat.poisson)
 COH_OVER_TENS = 4.0      # bond cohesion / tensile strength
 FRICTION_DEG = math.degrees(SAND["frictionAngle"])

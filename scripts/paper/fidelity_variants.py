@@ -1,5 +1,5 @@
 """One-at-a-time variants of the named modelling choices (yade_mpm_paper.fidelity.VARIANTS) on one scene, for
-the cause analysis of the fidelity table (issue 18, doc/validation.md): each run writes
+the cause analysis of the fidelity table (issue 18, doc/validation/report.md): each run writes
 OUT/<scene>_<case>_<variant>.json with what the rows need, and report.py builds the matrix choice × row.
 
     /usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial --case open --variants baseline,courant_1

@@ -11,7 +11,7 @@ of two cell layers; the crack faces carry the pressure P as a particle traction.
 
 Outer boundary (--edges, --edge-set): slip on the top and bottom faces by default — a supported block,
 whose crack grows stably; "free" is the unsupported block, whose crack runs to the edge once K(a) passes
-its minimum (doc/penny_crack.md). Damage options map onto DpGkMat parameters: --threshold-volume
+its minimum (doc/validation/penny_crack.md). Damage options map onto DpGkMat parameters: --threshold-volume
 (thresholdVolume, V of Eq. 37), --damage-strain (damageStrain, Eq. 36), --threshold-cell (thresholdCell,
 regularised threshold), --flaws/--flaw-seed (flawCount/flawSeed, Benz–Asphaug population).
 
@@ -23,7 +23,7 @@ stops is named under "stopped" with its message, the other runs still run, and t
 
     /usr/bin/python3 scripts/paper/penny_crack.py --out out/penny            # default
     /usr/bin/python3 scripts/paper/penny_crack.py --out out/penny --full     # paper time scale
-    yade-batch scripts/paper/penny_crack.table scripts/paper/penny_crack.py   # a study: one run per line (doc/studies.md)
+    yade-batch scripts/paper/penny_crack.table scripts/paper/penny_crack.py   # a study: one run per line (doc/guide/studies.md)
 """
 import argparse
 import math
@@ -166,7 +166,7 @@ def option_parser():
                     help="damage growth laws to run (DpGkMat.growthLaw): benz-asphaug = ε̄^(m/3) (default law), as-printed = Eq. 38 as printed")
     ap.add_argument("--threshold-volume", choices=CHOICES["thresholdVolume"], default=None,
                     help="V of Eq. 37 (DpGkMat.thresholdVolume): particle = particle area × 1 m (literal), cube = dp³, "
-                         "cell = l²·dp; default: the material's default (particle, doc/damage_growth_law.md)")
+                         "cell = l²·dp; default: the material's default (particle, doc/reference/damage_growth_law.md)")
     ap.add_argument("--damage-strain", choices=CHOICES["damageStrain"], default="uniaxial",
                     help="ε̄ of Eq. 36 (DpGkMat.damageStrain): uniaxial = σ̃max/(K + 4G/3) as printed, principal = max principal strain")
     ap.add_argument("--threshold-cell", type=float, default=0.0,
@@ -175,11 +175,11 @@ def option_parser():
     ap.add_argument("--flaw-seed", type=int, default=0, help="seed of the flaw population (DpGkMat.flawSeed)")
     ap.add_argument("--crack-nodes", choices=("shared", "excluded"), default="shared",
                     help="grid nodes on the crack mid-line: shared by both faces (paper) or excluded from the WLS fits "
-                         "(cases.line_crack's default, converges to Sneddon: doc/boundaries.md)")
+                         "(cases.line_crack's default, converges to Sneddon: doc/reference/boundaries.md)")
     ap.add_argument("--half-length", type=float, default=cases.CRACK_HALF_LENGTH, help="crack half-length c [m] (paper 0.2)")
     ap.add_argument("--edges", choices=("free", "slip", "fixed"), default="slip",
                     help="outer boundary of the block: slip (normal velocity 0, default: a supported block, "
-                         "doc/penny_crack.md), fixed, or free (the figure's unsupported block)")
+                         "doc/validation/penny_crack.md), fixed, or free (the figure's unsupported block)")
     ap.add_argument("--edge-set", choices=("topbottom", "all"), default="topbottom",
                     help="faces the --edges condition acts on: top and bottom (y = 0, L) or all four")
     ap.add_argument("--band", type=float, default=0.2, help="half height of the band around the crack line searched for D = 1 [m]")

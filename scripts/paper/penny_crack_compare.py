@@ -5,7 +5,7 @@ Reads `crack_extension_<growth law>.csv` and `summary.json` of each run director
               (0.02 m; runs on other grids are converted through their spacing), initiation time,
               deviation from 7 / 22 / 72 cells (RMS, largest), wall time;
   <out>.png   Δa(t_paper) of every run against the paper's points;
-and prints the same table as Markdown (for doc/penny_crack.md).
+and prints the same table as Markdown (for doc/validation/penny_crack.md).
 
     /usr/bin/python3 scripts/paper/penny_crack_compare.py --out doc/figures/penny_da "label a=out/run_a" "label b=out/run_b"
 """

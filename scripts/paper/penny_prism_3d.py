@@ -1,4 +1,4 @@
-"""A case only 3D can do (issue 22, item 4; doc/three_d.md): a 40 × 80 × 40 mm prism of Miao sandstone with
+"""A case only 3D can do (issue 22, item 4; doc/validation/three_d.md): a 40 × 80 × 40 mm prism of Miao sandstone with
 an inclined penny-shaped (disc) open flaw, 20 mm across, 2 mm thick, inclined 30° (the 2D through flaw's
 proportions), under uniaxial compression by the YADE platen (``yade_mpm_paper.cases.prism3d.penny_prism``), and
 the intact prism. Each run stops after the peak (as scripts/paper/uniaxial_flaw.py) and writes OUT/NAME/:

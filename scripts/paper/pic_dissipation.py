@@ -4,7 +4,7 @@ MUSL): a free 50 mm square block of the Miao sandstone (elastic), l = 2 mm, 2×2
 standing shear wave v_y = A sin(k x) (with its velocity gradient), no damping, no bodies. The total energy (kinetic +
 elastic) left after `--time` is written per Courant number and wavelength. The loss is per step, not per unit time: a
 smaller C loses more in the same time, so a run whose result is set by stress waves (crack growth after the first
-damage) depends on C and does not converge as C → 0 (doc/algorithm.md, "The particle velocity update and C").
+damage) depends on C and does not converge as C → 0 (doc/reference/algorithm.md, "The particle velocity update and C").
 
     /usr/bin/python3 scripts/paper/pic_dissipation.py --out out/pic_dissipation            # C = 1, 0.5, 0.25, 0.125
 Writes OUT/pic_dissipation.csv (courant, wavelength_cells, steps, time_us, energy_left).

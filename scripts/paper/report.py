@@ -1,9 +1,9 @@
-"""Builds doc/validation.md from the output folders of the reference scripts: every case's figures
+"""Builds doc/validation/report.md from the output folders of the reference scripts: every case's figures
 (copied to doc/figures/) and numbers, error against run time for the benchmarks, the stability table,
 the uniaxial sweeps, the fidelity table (every claim of the paper about its results, measured; yade_mpm_paper.fidelity.table) and the
 one-at-a-time variants behind it (scripts/paper/fidelity_variants.py).
 
-    /usr/bin/python3 scripts/paper/report.py                       # reads out/<case>/, writes doc/validation.md
+    /usr/bin/python3 scripts/paper/report.py                       # reads out/<case>/, writes doc/validation/report.md
     /usr/bin/python3 scripts/paper/report.py --root out --doc doc
 
 Folders read (each optional; a missing one is reported with the command that makes it):
@@ -33,7 +33,7 @@ from yade_mpm_paper.report.sections import circular, error_vs_time, penny, readm
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--root", default="out", help="folder holding the output folders (default out)")
-    ap.add_argument("--doc", default="doc", help="doc folder (default doc): writes validation.md and figures/")
+    ap.add_argument("--doc", default="doc", help="doc folder (default doc): writes validation/report.md and figures/")
     ap.add_argument("--dir", action="append", default=[], metavar="PART=DIR",
                     help=f"read PART from DIR instead of ROOT/PART (PART: {', '.join(PARTS)}); repeatable")
     a = ap.parse_args()

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Variants of the arch-tunnel scene (paper Sec. 4) for the Fig. 17 ordering study in doc/tunnel.md:
+"""Variants of the arch-tunnel scene (paper Sec. 4) for the Fig. 17 ordering study in doc/validation/tunnel.md:
 the axial stress at 0.25 / 0.5 / 0.75 / 1.0 mm (... up to --end-time) of platen displacement for one
 case with the rock made elastic, DP without damage or the full DP–GK, and the filler's friction changed.
 

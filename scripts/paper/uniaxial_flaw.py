@@ -16,7 +16,7 @@ sigma_max_open_vs_filled.png.
     yade-batch scripts/paper/uniaxial_flaw.table scripts/paper/uniaxial_flaw.py    # one job per line, OUT/<description>/
     /usr/bin/python3 scripts/studies/sweep.py scripts/paper/uniaxial_flaw.table scripts/paper/uniaxial_flaw.py   # the same on Dask
 
-Each invocation also writes OUT/summary.csv, one row per run (doc/studies.md).
+Each invocation also writes OUT/summary.csv, one row per run (doc/guide/studies.md).
 """
 import argparse
 import json

@@ -1,5 +1,5 @@
 """The uniaxial flaw specimen (paper Sec. 3.3) as a 3D slab against the 2D plane-strain run (issue 22,
-item 4; doc/three_d.md): the scene of ``yade_mpm_paper.cases.uniaxial_flaw`` with slab_cells = n (z ∈ [0, n·l],
+item 4; doc/validation/three_d.md): the scene of ``yade_mpm_paper.cases.uniaxial_flaw`` with slab_cells = n (z ∈ [0, n·l],
 slip planes on the front and back faces) and with slab_cells = 0 (2D), the same grid, rock, flaw and
 platen, both stopped after the peak as scripts/paper/uniaxial_flaw.py stops. Writes OUT/2d/ and OUT/3d/
 (curve.csv: time, axial strain, axial stress; run.json; particles.pvd + .vtu series; snapshots.npz),
@@ -33,7 +33,7 @@ def parse(argv=None):
     p.add_argument("--slab-cells", type=int, default=cases.UNIAXIAL_SLAB_CELLS, help="slab thickness [cells] (default %(default)s)")
     p.add_argument("--variant", default="open", choices=("open", "intact"), help="flaw (default %(default)s)")
     p.add_argument("--threshold-volume", default=None, choices=("particle", "cube", "cell"),
-                   help="V of Eq. 37 for both runs (default: the rock's, 'particle': 2D area × 1 m against 3D dp³, doc/three_d.md)")
+                   help="V of Eq. 37 for both runs (default: the rock's, 'particle': 2D area × 1 m against 3D dp³, doc/validation/three_d.md)")
     p.add_argument("--only", choices=("2d", "3d"), default=None, help="run one of the two (the other is read from OUT)")
     p.add_argument("--end-time", type=float, default=END_TIME, help="loading time cap [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=60.0, help="wall seconds between progress lines")

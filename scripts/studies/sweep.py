@@ -6,7 +6,7 @@ YADE_BATCH=TABLE:LINE, as yade-batch runs it), on this machine or on many.
 
 LocalCluster: workers = cores / --threads-per-run, one run at a time each. A running cluster: start
 `dask-scheduler` on one node and `dask-worker tcp://HOST:8786 --nthreads RUNS` on every node (under Slurm:
-one worker per node, doc/studies.md); the table, the script and the study folder must be on a file system
+one worker per node, doc/guide/studies.md); the table, the script and the study folder must be on a file system
 every node sees, at the same path. A line runs in its own folder OUT/<description>/ (yade_mpm_paper.batch) with
 its log in log.txt; a line whose summary.csv exists is skipped (resume = the same command again); a line
 that fails (bad parameter, solver error, its worker died) is reported with its message and log and the
@@ -30,7 +30,7 @@ from yade_mpm_paper import batch  # noqa: E402
 def parse(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=__doc__.split("\n\n", 1)[1])
-    ap.add_argument("table", help="parameter table (yade-batch format; doc/studies.md)")
+    ap.add_argument("table", help="parameter table (yade-batch format; doc/guide/studies.md)")
     ap.add_argument("script", help="the script every line runs (it reads its line with readParamsFromTable)")
     ap.add_argument("--scheduler", default=None, help="address of a running Dask scheduler, tcp://HOST:8786 (default: a LocalCluster)")
     ap.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: cores / threads per run)")

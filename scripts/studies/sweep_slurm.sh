@@ -1,5 +1,5 @@
 #!/bin/bash
-# A study on a Slurm cluster (doc/studies.md): the Dask scheduler and scripts/studies/sweep.py on the first node of
+# A study on a Slurm cluster (doc/guide/studies.md): the Dask scheduler and scripts/studies/sweep.py on the first node of
 # the allocation, one dask-worker per node (srun), each running cpus-per-task / THREADS_PER_RUN lines at a time.
 # Run from the checkout, on a file system every node sees at the same path (the table's `out` is relative to it):
 #   sbatch --nodes=4 --cpus-per-task=32 scripts/studies/sweep_slurm.sh scripts/paper/tunnel_spalling.table scripts/paper/tunnel_spalling.py

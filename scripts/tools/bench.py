@@ -18,7 +18,7 @@ through YADE's O.run (MpmEngine hook) versus direct stepping, for the hook overh
 
 Writes DIR/summary.json ({cases: [{case, dim, material, contact, particles, threads,
 particle_steps_per_s, ns_per_particle_step, phases, bytes_per_particle, ...}], hook: {...}}) and
-DIR/table.md (the table in doc/performance.md)."""
+DIR/table.md (the table in doc/developer/performance.md)."""
 import argparse
 import json
 import os

@@ -1,12 +1,12 @@
 """Per-step wall time of the benchmark block (scripts/tools/bench.py's build_scene: granite on a fixed floor,
-slip side walls, initial pure-shear velocity) on 1 process or N MPI ranks (doc/scaling.md):
+slip side walls, initial pure-shear velocity) on 1 process or N MPI ranks (doc/developer/scaling.md):
 
     /usr/bin/python3 scripts/tools/mpi_bench.py --cells 50 50 25            # serial core
     scripts/tools/mpi_run.sh 2 1 scripts/tools/mpi_bench.py --cells 50 50 25      # 2 ranks × 1 thread
 
 Every rank prints one JSON line (rank, particles, seconds per step, phase times per step); the ranks
 step in lock-step (two shared-node exchanges and one reduction per step), so rank 0's time is the
-step time. Timings on a loaded host are labelled as such in doc/scaling.md."""
+step time. Timings on a loaded host are labelled as such in doc/developer/scaling.md."""
 import argparse
 import json
 import os

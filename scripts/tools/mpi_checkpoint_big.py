@@ -1,5 +1,5 @@
 """Checkpoint and bitwise resume of a large 3D run on N MPI ranks (issue 22's bar: ≥ 2 million particles
-under ``mpirun -np 2``; doc/scaling.md "Checkpoints"). An elastic block (2 particles per cell per axis)
+under ``mpirun -np 2``; doc/developer/scaling.md "Checkpoints"). An elastic block (2 particles per cell per axis)
 with a shearing initial velocity and gravity:
 
     scripts/tools/mpi_run.sh 2 1 scripts/tools/mpi_checkpoint_big.py save   --out out/mpi_ck   # K steps, save, K steps

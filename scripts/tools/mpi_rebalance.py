@@ -1,4 +1,4 @@
-"""Wall time of a scene whose material moves, with and without dynamic load balance (doc/scaling.md):
+"""Wall time of a scene whose material moves, with and without dynamic load balance (doc/developer/scaling.md):
 the drifting block of `yade_mpm_paper.cases.drifting_block` on N MPI ranks.
 
     scripts/tools/mpi_run.sh 2 1 scripts/tools/mpi_rebalance.py --spacing 0.00125 --steps 700                  # re-cut at 1.1

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Runs a yade_mpm script on N MPI ranks of this machine with Debian's Open MPI (doc/scaling.md):
+# Runs a yade_mpm script on N MPI ranks of this machine with Debian's Open MPI (doc/developer/scaling.md):
 #   scripts/tools/mpi_run.sh N [THREADS] script.py [args…]
 # N ranks × THREADS OpenMP threads each (default 1). Every rank runs the same script; yade_mpm loads its
 # MPI core (_core_mpi) because mpirun sets OMPI_COMM_WORLD_SIZE. --oversubscribe allows more ranks than
@@ -16,7 +16,7 @@ if [[ "$1" =~ ^[0-9]+$ ]]; then T=$1; shift; fi
 here=$(cd "$(dirname "$0")/../.." && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 # A rank waiting in MPI yields its core (shared or loaded hosts: busy polling slowed the 2-rank tunnel
-# 3.9×, doc/scaling.md); OMPI_MCA_mpi_yield_when_idle=0 restores Open MPI's polling on dedicated cores.
+# 3.9×, doc/developer/scaling.md); OMPI_MCA_mpi_yield_when_idle=0 restores Open MPI's polling on dedicated cores.
 export OMPI_MCA_mpi_yield_when_idle=${OMPI_MCA_mpi_yield_when_idle:-1}
 export OMP_NUM_THREADS=$T
 export PYTHONPATH="$here/py${PYTHONPATH:+:$PYTHONPATH}"

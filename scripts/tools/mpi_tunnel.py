@@ -1,5 +1,5 @@
 """The 2 mm DP–GK arch tunnel (intact; paper Sec. 4, ``cases.arch_tunnel``) on N MPI ranks against 1
-process (doc/scaling.md, issue 22's bar: axial stress at 0.5 / 1 / 2 mm within 0.5 %, the first crack at
+process (doc/developer/scaling.md, issue 22's bar: axial stress at 0.5 / 1 / 2 mm within 0.5 %, the first crack at
 the same place). Two modes:
 
     scripts/tools/mpi_run.sh 2 1 scripts/tools/mpi_tunnel.py run --out out/mpi_tunnel/two    # 2 ranks × 1 thread

@@ -15,7 +15,7 @@ is bitwise identical to the uninterrupted one for the same thread count. The scr
 as usual and ``load`` overwrites its state, after checking the whole file: a truncated or corrupted
 file, another format or build of the core, or another scene (grid, particles, materials, loads, contact
 parameters, YADE bodies and engines) is refused with a ``CheckpointError`` (a ``ValueError``), nothing changed. The
-``MpmEngine`` registry is restored after ``O.load`` (doc/checkpoint.md). The run-loop side, periodic
+``MpmEngine`` registry is restored after ``O.load`` (doc/guide/checkpoints.md). The run-loop side, periodic
 checkpoints and clean stops on SIGINT / SIGTERM, is ``Checkpointer`` and ``ResumableRun`` in
 ``yade_mpm.checkpoint.resumable``. On N > 1 MPI ranks: a piece per rank and an index, resumed by the same rank
 count only (``yade_mpm.checkpoint.mpi``).

@@ -1,4 +1,4 @@
-"""Checkpoints of a run on N MPI ranks (doc/scaling.md "Checkpoints"; used by ``yade_mpm.checkpoint``).
+"""Checkpoints of a run on N MPI ranks (doc/developer/scaling.md "Checkpoints"; used by ``yade_mpm.checkpoint``).
 
 ``checkpoint.save(path)`` on N > 1 ranks writes one piece per rank, ``path.rK`` (K = 0 … N − 1: the rank's
 particles in storage order, its block schedule, the slab layout, the replicated YADE scene and the clock,

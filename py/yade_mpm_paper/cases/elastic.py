@@ -1,5 +1,5 @@
 """Elastic reference scenes: the circular opening (paper Sec. 3.1, against Kirsch), the pressurised
-line crack (Sec. 3.2, against Sneddon) and the boundary checks of doc/boundaries.md."""
+line crack (Sec. 3.2, against Sneddon) and the boundary checks of doc/reference/boundaries.md."""
 import numpy as np
 
 from yade_mpm import rocks
@@ -35,7 +35,7 @@ def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="con
     particle at the in-situ stress (σxx, σyy) = (−20, −10) MPa, σzz = ν(σxx + σyy) (plane strain), and
     the far-field traction on its faces, so only the hole wall is out of balance ("excavation").
     material: default ``rocks.granite()``. quarter=True models the quadrant x, y ≥ 2.5 m only, with
-    slip (symmetry) planes on x = 2.5 m and y = 2.5 m (doc/boundaries.md). Returns (solver, lo, hi)."""
+    slip (symmetry) planes on x = 2.5 m and y = 2.5 m (doc/reference/boundaries.md). Returns (solver, lo, hi)."""
     mat = material or rocks.granite()
     lo, hi = np.full(2, OPENING_CENTER - domain / 2), np.full(2, OPENING_CENTER + domain / 2)
     if quarter:
@@ -64,7 +64,7 @@ def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="ex
     between the faces out of the WLS fits (``add_region(gap_nodes="excluded")``, ``scene.thin_gap_nodes``):
     the faces are 2 cells apart and the cubic B-spline reaches 2 cells, so with "shared" (the paper's
     construction) both faces map to the mid-line node row and stay tied — the opening then moves away
-    from Sneddon as the grid is refined (doc/boundaries.md).
+    from Sneddon as the grid is refined (doc/reference/boundaries.md).
 
     Returns (solver, geo): geo = dict(xc, yc, h, dp, x0 (initial positions by id), top, bot (particle
     ids of the loaded face rows), half_length)."""
@@ -92,7 +92,7 @@ def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="ex
 
 
 # ------------------------------------------------------------------------------------------------
-# Boundary checks (doc/boundaries.md)
+# Boundary checks (doc/reference/boundaries.md)
 def uniform_stress_block(dim, axis, side, kind="slip", cells=8, spacing=0.1, sigma=-40e6, damping=0.1, material=None):
     """Block [0, cells·l]^dim under a uniform normal stress σ [Pa] along `axis` (every particle starts at it),
     resting on a boundary plane of `kind` at its face `side` (−1 low, +1 high); the opposite face carries the
@@ -150,7 +150,7 @@ def mode_period(solver, shape, t_end):
 def drifting_block(spacing=0.01, speed=35.0, rebalance=1.1):
     """A 0.1 × 0.24 m soft elastic block (E = 2 MPa, ν = 0.25, ρ = 2000 kg/m³: c_p ≈ 37 m/s) drifting up a
     0.64 m tall empty grid at `speed` [m/s] with a little shear (±1 m/s along y, ±0.5 m/s along x): the
-    material leaves the MPI slabs it started in (the load-balance scene of doc/scaling.md). `rebalance`
+    material leaves the MPI slabs it started in (the load-balance scene of doc/developer/scaling.md). `rebalance`
     is Solver.mpiRebalance (inf: never re-cut). Returns the solver."""
     s = make_solver((-0.03, 0.0), (0.13, 0.64), spacing, margin=2)
     add_region(s, ElasticMat(young=2e6, poisson=0.25, density=2000.0), (0.0, 0.0), (0.1, 0.24))

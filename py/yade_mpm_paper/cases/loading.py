@@ -4,7 +4,7 @@ import math
 
 PLATEN_SPEED = 0.1                 # downward velocity of the rigid top platen [m/s] (paper Secs. 3.3, 4)
 PLATEN_FRICTION = 0.0              # platen–rock μ_con [-]: the paper's free-slip top
-FILLER_CHI = 0.5                   # filler–rock residual penetration factor χ [-] (doc/tunnel.md, doc/contact.md)
+FILLER_CHI = 0.5                   # filler–rock residual penetration factor χ [-] (doc/validation/tunnel.md, doc/reference/contact.md)
 BODY_HALF_THICKNESS = 0.5          # YADE box half-extent along z [m]: thickness 1 m
 
 
@@ -34,12 +34,12 @@ def blocked_dofs(value, name="blockedDOFs"):
 
 def yade_filler(rb, flaw, friction, cohesion=0.0, density=None, blocked="zXY", chi=None, law=None):
     """A free rigid YADE Box that is the flaw (dict of ``tunnel_flaw``): the domain of the filling, its
-    length × width, registered in `rb` with d0 = "initial" (doc/contact.md) so the particles next to it —
+    length × width, registered in `rb` with d0 = "initial" (doc/reference/contact.md) so the particles next to it —
     the flaw is cut from the particle lattice, its faces are jagged — touch it at zero force from t = 0;
     free in the plane (blockedDOFs `blocked`, default 'zXY'; 'zXYZ' also blocks its rotation); μ = friction
     [-], c = cohesion [Pa], χ = chi [-] (None: FILLER_CHI); density [kg/m³] (None: YADE's default 1000):
     its true mass, lighter than the grid nodes along its faces — the stick step moves it with its contact
-    nodes (doc/contact.md). The grid nodes it covers get the contact exclusion bit, as an open flaw's nodes
+    nodes (doc/reference/contact.md). The grid nodes it covers get the contact exclusion bit, as an open flaw's nodes
     get the user bit. law: contact law (None: the declared default). Returns its YADE id."""
     from yade import O, utils
     from yade.minieigenHP import Quaternion, Vector3

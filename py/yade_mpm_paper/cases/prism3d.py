@@ -1,4 +1,4 @@
-"""A case only 3D can do (issue 22, item 4; doc/three_d.md): a prism of Miao sandstone under uniaxial
+"""A case only 3D can do (issue 22, item 4; doc/validation/three_d.md): a prism of Miao sandstone under uniaxial
 compression by the YADE platen of the uniaxial flaw scene, with an inclined penny-shaped (disc) open flaw
 at its centre — the 3D counterpart of paper Sec. 3.3's through flaw, with the 2D scene's proportions,
 rock, flaw inclination and thickness, platen and base."""

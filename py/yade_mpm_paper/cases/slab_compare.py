@@ -1,4 +1,4 @@
-"""The 3D slab against 2D plane strain (issue 22, item 4; doc/three_d.md): the uniaxial flaw specimen of
+"""The 3D slab against 2D plane strain (issue 22, item 4; doc/validation/three_d.md): the uniaxial flaw specimen of
 ``uniaxial_flaw`` run once in 2D and once as a slab between slip planes (``slab_cells``), and the numbers
 that compare their stress–strain curves. Written once for scripts/paper/uniaxial_flaw_3d.py and the tests."""
 import numpy as np
@@ -11,7 +11,7 @@ SMOOTH_TRAVEL = 1e-5     # window of the running mean of a curve [m of platen tr
 def smooth(eps, sig, height, travel=SMOOTH_TRAVEL):
     """The stress averaged over every `travel` [m] of platen travel (strain bins of travel/height [-]):
     (bin-centre strains, mean stresses). The per-step reaction of the penalty contact rings at the step
-    frequency; the bins average that ringing out, as the tunnel's curves do (doc/scaling.md)."""
+    frequency; the bins average that ringing out, as the tunnel's curves do (doc/developer/scaling.md)."""
     eps, sig = np.asarray(eps, float), np.asarray(sig, float)
     k = np.floor(eps / (travel / height)).astype(int)
     keep = k >= 0

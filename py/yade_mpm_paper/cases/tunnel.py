@@ -57,7 +57,7 @@ def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floo
 # The flaw of Figs. 16b, c. The paper gives its size (60 mm × 2 mm, "adjacent to the tunnel", on its
 # left) but not its position or angle; they are chosen from the description of Fig. 19 (the flaw
 # hinders the load path from the top to the left waist; stress concentrates at the flaw toe, next to
-# the left spandrel; a crack links the toe to the tunnel corner) — see doc/tunnel.md. One place only:
+# the left spandrel; a crack links the toe to the tunnel corner) — see doc/validation/tunnel.md. One place only:
 FLAW_LENGTH = 0.06                 # [m]
 FLAW_WIDTH = 0.002                 # [m]
 FLAW_ANGLE_DEG = 60.0              # inclination to the horizontal [°]; rises to the left, away from the tunnel
@@ -220,7 +220,7 @@ def tunnel_where(points, flaw=None, floor=TUNNEL_FLOOR):
     return " and ".join([str(uniq[k]) for k in order if cnt[k] >= 0.25 * cnt.max()][:2])
 
 
-# crack analytics of the tunnel (doc/tunnel.md)
+# crack analytics of the tunnel (doc/validation/tunnel.md)
 BAND_GAP = 5e-3                    # shear bands are looked for beyond this distance from the opening and the flaw [m]
 BAND_FRACTION, BAND_MIN = 0.5, 5e-4  # band particles: ε̄p ≥ max(BAND_MIN, BAND_FRACTION × its 99th percentile there)
 TOE_RADIUS = 4e-3                  # the failed zone "from the flaw toe" starts within this distance of it [m]

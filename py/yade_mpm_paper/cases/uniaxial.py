@@ -17,7 +17,7 @@ UNIAXIAL_PAPER_SPACING = 0.5e-3    # the paper's grid [m]
 UNIAXIAL_VARIANTS = ("intact", "open", "filled")
 UNIAXIAL_MAX_SPACING = UNIAXIAL_WIDTH / 10   # coarsest grid [m]: 10 cells across the specimen (a coarser one ran with 3–5 particles)
 UNIAXIAL_SIDE_ROOM = 0.05          # grid beyond each free side face and above the top [m]: spalled fragments (measured up to 14 m/s) stay on the grid
-UNIAXIAL_SLAB_CELLS = 2            # thickness of the 3D slab (slab_cells > 0) in grid cells [-] (doc/three_d.md)
+UNIAXIAL_SLAB_CELLS = 2            # thickness of the 3D slab (slab_cells > 0) in grid cells [-] (doc/validation/three_d.md)
 
 
 def uniaxial_flaw_geometry(width=UNIAXIAL_WIDTH, height=UNIAXIAL_HEIGHT, flaw=UNIAXIAL_FLAW):
@@ -59,25 +59,25 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
                         under 4 cells wide: exclude_nodes_inside),
               "filled"  the flaw cut out and filled by a free rigid YADE Box (rock density) in PTS
                         contact with μ_con = mu_con [-] and c_con = c_con [Pa].
-    filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/contact.md).
+    filler_blocked: the filler's blockedDOFs ('zXYZ' keeps it from rotating; see doc/reference/contact.md).
     ramp_time [s] ≥ 0: the platen speed rises linearly from 0 over this time when the run is driven by
     scene["advance"](n) (speed updated before each call: a staircase with n-step treads); 0 (default) starts at
     full speed. end_cap_cells ≥ 0: the particles within this many cells of the base and of the platen get a
     Grady–Kipp activation strain ε_D⁰ = 0.99 (Eq. 37) that tension never reaches — "end caps", so the layer
-    under the penalty contact does not crack first (doc/mpm_vs_bonded.md); 0 (default) = none.
+    under the penalty contact does not crack first (doc/validation/mpm_vs_bonded.md); 0 (default) = none.
     side_room [m] > 0: grid beyond each free side face and above the specimen's top, beside the platen (default
     UNIAXIAL_SIDE_ROOM): a top corner that fails is squeezed out sideways at up to 10 m/s and rises past the
     platen's edge (the 0.5 mm, c_con = 5 MPa run lost such a particle 1 mm above the top at 10.9 ms when the grid
     ended 2 cells above the specimen).
     slab_cells ≥ 0: 0 (default) = 2D plane strain; n > 0 = the same specimen as a 3D slab n cells thick
     (z ∈ [0, n·l]) between two slip (symmetry) planes on its front and back faces, i.e. plane strain
-    imposed by the boundary instead of the kinematics (doc/three_d.md); the flaw is a through prism and the
+    imposed by the boundary instead of the kinematics (doc/validation/three_d.md); the flaw is a through prism and the
     platen spans the slab (1 m along z); variants "intact" and "open". The 2D parameters above hold unchanged.
     platen_d0: the platen's contact detection distance [m] (None, default: half the particle edge ½V^(1/D) of
     the current volume, which differs between 2D and 3D once the volume changes; a number makes a slab
-    and the 2D run identical to roundoff, doc/three_d.md).
+    and the 2D run identical to roundoff, doc/validation/three_d.md).
     contact_law: the law of the platen and filler contacts, "kinematic" or "penalty" (None: the declared default;
-    doc/contact.md).
+    doc/reference/contact.md).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),

@@ -1,4 +1,4 @@
-"""Measurements behind the fidelity table of doc/validation.md (issue 18): what a run records so that
+"""Measurements behind the fidelity table of doc/validation/report.md (issue 18): what a run records so that
 each claim the paper makes about its results (Figs. 4–19) has a measured counterpart, and the named
 modelling choices varied one at a time to find the cause of a row that differs.
 

@@ -1,4 +1,4 @@
-"""The validation report, doc/validation.md (scripts/paper/report.py is its command line):
+"""The validation report, doc/validation/report.md (scripts/paper/report.py is its command line):
 
     document           the folders read, the Markdown being written, figures, tables, notes
     sections           the reproduced cases: benchmarks, circular opening, line crack, stability, uniaxial, tunnel

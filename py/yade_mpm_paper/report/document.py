@@ -1,4 +1,4 @@
-"""The validation report's document (scripts/paper/report.py builds doc/validation.md with it): the output
+"""The validation report's document (scripts/paper/report.py builds doc/validation/report.md with it): the output
 folders it reads and the commands that make them, the Markdown lines with their figures copied to
 doc/figures/, number and table formatting, notes included verbatim and the frozen record's link."""
 import glob
@@ -39,6 +39,7 @@ class Report:
     def __init__(self, root, doc, dirs=None):
         self.root, self.doc, self.dirs = root, doc, dict(dirs or {})
         self.fig_dir = os.path.join(doc, "figures")
+        self.path = os.path.join(doc, "validation", "report.md")
         os.makedirs(self.fig_dir, exist_ok=True)
         self.lines = []
 
@@ -68,7 +69,7 @@ class Report:
             return False
         dst = os.path.join(self.fig_dir, name)
         shutil.copyfile(src, dst)
-        rel = os.path.relpath(dst, self.doc)
+        rel = os.path.relpath(dst, os.path.dirname(self.path))
         self.w(f"![{caption}]({rel})" if width is None else f'<img src="{rel}" width="{width}" alt="{caption}">', f"*{caption}*", "")
         return True
 
@@ -80,10 +81,10 @@ class Report:
                     self.figure(p, f"{part}_{os.path.basename(p)}", f"{part}: {os.path.basename(p)}")
 
     def write(self):
-        path = os.path.join(self.doc, "validation.md")
-        with open(path, "w") as f:
+        os.makedirs(os.path.dirname(self.path), exist_ok=True)
+        with open(self.path, "w") as f:
             f.write("\n".join(self.lines).rstrip() + "\n")
-        return path
+        return self.path
 
 
 def fmt(v, nd=3):
@@ -115,6 +116,6 @@ FROZEN = "paper_grid_and_courant_7ac11e5.md"      # the last paper-grid tunnel r
 
 
 def frozen(R):
-    """Link the frozen record of sections whose outputs are not here (doc/FROZEN)."""
-    if os.path.exists(os.path.join(REPO, "doc", FROZEN)):
-        R.w(f"The last runs of this section (main `7ac11e5`, simulation code of `d734961`) are kept verbatim in [{FROZEN}]({FROZEN}).", "")
+    """Link the frozen record of sections whose outputs are not here (archive/FROZEN)."""
+    if os.path.exists(os.path.join(REPO, "archive", FROZEN)):
+        R.w(f"The last runs of this section (main `7ac11e5`, simulation code of `d734961`) are kept verbatim in [{FROZEN}](../../archive/{FROZEN}).", "")

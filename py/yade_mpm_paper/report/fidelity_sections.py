@@ -60,24 +60,24 @@ def variant_matrix(R, folder="fidelity_variants"):
     R.w("## Causes: one-at-a-time variants of the modelling choices", "")
     if not files:
         R.w(f"*Not run here* — `/usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial|tunnel ...` writes `{shown(os.path.join(R.root, folder))}/`.", "")
-        if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
+        if os.path.exists(os.path.join(REPO, "archive", "fidelity_variants_d734961.md")):
             R.w("The last screening matrix (build before issue 17's contact fix, C = 0.5) is kept verbatim in "
-                "[fidelity_variants_d734961.md](fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
+                "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
         return
     runs = [json.load(open(f)) for f in files]
-    if os.path.exists(os.path.join(REPO, "doc", "fidelity_variants_d734961.md")):
+    if os.path.exists(os.path.join(REPO, "archive", "fidelity_variants_d734961.md")):
         done = {(r["scene"], r["variant"]) for r in runs}
         old = [n for v, n in (("as_printed_growth", "uniaxial growth law"), ("v_cube", "V = dp³"), ("no_residual_cohesion", "residual cohesion"),
                               ("soft_strain_0.01", "ε̄p,crit = 0.01")) if ("uniaxial", v) not in done] + ["tunnel intact at 2.5 mm"]
         R.w(f"Variants not in the matrix below ({', '.join(old)}) were screened on an older build (before issue 17's contact fix): "
-            "[fidelity_variants_d734961.md](fidelity_variants_d734961.md), kept verbatim.", "")
-    if os.path.exists(os.path.join(REPO, "doc", OLD_INCREMENT)):
+            "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md), kept verbatim.", "")
+    if os.path.exists(os.path.join(REPO, "archive", OLD_INCREMENT)):
         done = {r["variant"] for r in runs if r["scene"] == "tunnel"}
         old = [n for v, n in (("principal_strain", "Eq. 36 as the principal strain"), ("floor_52.5mm", "the opening centred"),
                               ("flaw_gap_5mm", "the flaw toe 5 mm from the wall")) if v not in done]
         if old:
             R.w("Tunnel variants screened with the earlier default ε̄p increment (Δλ/√3, now `plasticStrainIncrement = 'von-mises'`) "
-                f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}]({OLD_INCREMENT}).", "")
+                f"and not re-run on this build — {', '.join(old)} — are kept verbatim in [{OLD_INCREMENT}](../../archive/{OLD_INCREMENT}).", "")
     include_notes(R, os.path.join(R.root, folder, "notes.md"))
     from yade_mpm_paper import fidelity
     for scene, case in sorted({(r["scene"], r["case"]) for r in runs}):

@@ -1,6 +1,7 @@
 """The stability suite: the checked run that watches every step of the small scenes that push the explicit
 WLS-MPM step to its limits (the scenes: yade_mpm_paper.validation.stability_cases; scripts/paper/stability.py
-is the suite's command line, tests/test_stability.py runs the coarse versions; doc/stability.md has the results).
+is the suite's command line, tests/test_stability.py runs the coarse versions; doc/validation/stability.md has the
+results).
 
 Every step of every case is checked for
   * non-finite particle state (position, velocity, stress, volume, damage) or energy,
