@@ -11,6 +11,7 @@ the median is reported (2 threads on a shared host are noisy).
 Cases: 2D elastic 80 k and 1 M particles, 2D DP–GK 80 k (loaded so that a good share yields and
 some particles damage), 3D elastic 500 k; each with 1 and 2 threads; and the 2D DP–GK 80 k scene
 through YADE's O.run (MpmEngine hook) versus direct stepping, for the hook overhead.
+The scenes and their timed runs (the child process) are in bench_scenes.py beside this script.
 
     /usr/bin/python3 scripts/tools/bench.py --out results/bench            # full matrix (~10 min)
     /usr/bin/python3 scripts/tools/bench.py --out /tmp/b --quick           # fewer steps/repeats, no 1 M / 3D
@@ -27,98 +28,9 @@ import subprocess
 import sys
 import time
 
+from bench_scenes import CASES, CONTACT_CASE, PAPER, QUICK_STEPS, SPACING, SPHERES, child  # the sibling module: scenes, timed runs
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-
-# name: (dim, material, cells per axis of the particle block, timed steps, warm-up steps)
-CASES = {
-    "elastic2d_80k": (2, "elastic", (200, 100), 300, 20),
-    "elastic2d_1m": (2, "elastic", (500, 500), 40, 5),
-    "dpgk2d_80k": (2, "dpgk", (200, 100), 300, 20),
-    "elastic3d_500k": (3, "elastic", (50, 50, 25), 30, 3),
-}
-QUICK_STEPS = {"elastic2d_80k": 100, "elastic2d_1m": 15, "dpgk2d_80k": 100, "elastic3d_500k": 10}
-
-SPACING = 0.01  # grid spacing l [m]; 2 particles per cell per axis
-
-
-def build_scene(dim, material, cells):
-    """The benchmark block: rock on a fixed floor with slip side walls, deformed by an initial
-    pure-shear velocity field v = ε̇ (x − x_c) along x and −ε̇ (y − y_c) along y, so the stress grows
-    to the DP–GK yield and damage thresholds within the warm-up. Returns the solver."""
-    import yade_mpm as ym
-    from yade_mpm import rocks
-    size = [c * SPACING for c in cells]
-    lo, hi = (0.0,) * dim, tuple(size)
-    s = ym.make_solver(lo, hi, SPACING, margin=3)
-    # the paper's granite (Sec. 3.1), elastic or with the DP–GK parameters of Sec. 3.2: at this strain
-    # rate most particles yield and damage during the timed steps
-    mat = rocks.granite() if material == "elastic" else rocks.granite_dpgk()
-    ym.add_region(s, mat, lo, hi, ppc=2)
-    s.addBoundaryPlane(1, -1, 0.0, "fixed")
-    s.addBoundaryPlane(0, -1, 0.0, "slip")
-    s.addBoundaryPlane(0, +1, size[0], "slip")
-    s.gravity = (0.0, -9.81) if dim == 2 else (0.0, -9.81, 0.0)
-    rate = 40.0  # ε̇ [1/s]
-    x0, x1 = s.view("x0"), s.view("x1")
-    s.view("v0")[:] = rate * (x0 - 0.5 * size[0])
-    s.view("v1")[:] = -rate * x1
-    return s
-
-
-# Paper-scale scenes (timed for a few hundred steps; the wall time of the full run is extrapolated).
-PAPER = {
-    # Sec. 3.2: 5 m × 5 m plane-strain block, l = 0.02 m, 0.4 m line crack (two cell layers removed),
-    # P = 75 MPa on the faces; DP–GK rock. The paper runs 0.4 s of a 0.5 s ramp.
-    "penny_paper_250k": dict(end_time=0.4, steps=150, warmup=30),
-    # Sec. 4: 150 mm × 150 mm sandstone with the arch-shaped tunnel (40 × 25 mm rectangle + 20 mm
-    # semicircle), l = 1 mm, 20 ms of loading: cases.arch_tunnel("intact") stepped through YADE with its
-    # rigid platen in PTS contact, as scripts/paper/tunnel_spalling.py runs it, at the scene's default Courant number.
-    "tunnel_paper_83k": dict(end_time=0.02, steps=300, warmup=30),
-}
-
-
-def build_paper(name):
-    import yade_mpm as ym
-    from yade_mpm import rocks
-    from yade_mpm_paper import cases
-    if name == "penny_paper_250k":
-        # full pressure within the warm-up: damage grows at the tips while timed
-        s, _ = cases.line_crack(5.0, 0.02, rocks.granite_dpgk(), 75e6, ramp=2e-4, damping=0.05)
-        return s
-    s, _ = cases.arch_tunnel("intact", 1e-3)
-    return s
-
-
-def run_paper(name, steps, warmup):
-    """Child process: time `steps` steps of a paper-scale scene; extrapolate to its simulated end time."""
-    advance = None
-    if name.startswith("tunnel"):
-        from yade import O
-        advance = lambda n: [O.step() for _ in range(n)]   # the platen moves with YADE's NewtonIntegrator
-    out, s = timed(lambda: build_paper(name), steps, warmup, advance)
-    out.update(dt=s.lastDt, courant=s.courant)
-    return out
-
-
-def timed(build, steps, warmup, advance=None):
-    """Build a scene (`build()` → solver), run `warmup` steps, then time `steps` more with nothing else
-    happening: wall and CPU seconds, phase times, particles, storage and peak-RSS growth per particle,
-    threads and the plastic/damaged shares. advance(n) steps the scene (default: Solver.run, the C++
-    loop). Returns (result dict, solver)."""
-    import yade_mpm as ym
-    rss0 = peak_rss_bytes()
-    s = build()
-    advance = advance or s.run   # (a YADE scene passes its own: O.step)
-    advance(warmup)
-    s.resetPhaseTimes()
-    c0, t0 = time.process_time(), time.perf_counter()
-    advance(steps)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles,
-               bytes_per_particle=s.bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
-               threads=ym.getThreads())
-    out.update(material_stats(s))
-    return out, s
 
 
 def host_probe(nproc, secs=2.0):
@@ -130,157 +42,6 @@ def host_probe(nproc, secs=2.0):
     ps = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(nproc)]
     cpu = sum(float(p.communicate()[0]) for p in ps)
     return cpu / (time.time() - t0)
-
-
-def peak_rss_bytes():
-    import resource
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
-
-def run_direct(name, steps, warmup):
-    """Child process: build, warm up, time `steps` solver steps."""
-    dim, material, cells, _, _ = CASES[name]
-    return timed(lambda: build_scene(dim, material, cells), steps, warmup)[0]
-
-
-def material_stats(s):
-    """Share of particles that are plastic / damaged at the end (DP–GK), to show the scene is loaded."""
-    import numpy as np
-    try:
-        eps, dmg = s.view("epsP"), s.view("damage")
-    except ValueError:
-        return {}
-    return dict(plastic_fraction=float(np.mean(eps > 0)), damaged_fraction=float(np.mean(dmg > 0)))
-
-
-def run_yade(name, steps, warmup):
-    """Child process: the same scene through YADE's loop (O.run with the MpmEngine PyRunner)."""
-    import yade_mpm as ym
-    from yade import O
-    from yade.wrapper import ForceResetter, NewtonIntegrator
-    dim, material, cells, _, _ = CASES[name]
-
-    def build():
-        s = build_scene(dim, material, cells)
-        O.engines = [ForceResetter(), ym.MpmEngine(s, label="mpmbench").runner(), NewtonIntegrator()]
-        O.dt = 1.0
-        return s
-    return timed(build, steps, warmup, advance=lambda n: O.run(n, True))[0]
-
-
-def run_hook_probe(name, steps, warmup):
-    """Child process: the fixed per-step cost of the YADE hook (PyRunner call, Δt negotiation, YADE's own
-    engines) on a tiny scene, where it is not hidden in the stepping cost: O.run vs Solver.run per step."""
-    import yade_mpm as ym
-    from yade import O
-    from yade.wrapper import ForceResetter, NewtonIntegrator
-
-    def tiny():
-        s = ym.make_solver((0, 0), (0.1, 0.1), 0.01)
-        ym.add_region(s, ym.rocks.granite(), (0, 0), (0.1, 0.1))
-        return s
-    a, b = tiny(), tiny()
-    e = ym.MpmEngine(a, label="mpmprobe")
-    O.engines = [ForceResetter(), e.runner(), NewtonIntegrator()]
-    O.dt = 1.0
-    O.run(warmup, True)
-    b.run(warmup)
-    ty, td = [], []
-    for _ in range(5):  # interleaved blocks, minimum of each: robust against other processes
-        t0 = time.perf_counter()
-        O.run(steps, True)
-        ty.append((time.perf_counter() - t0) / steps)
-        t0 = time.perf_counter()
-        b.run(steps)
-        td.append((time.perf_counter() - t0) / steps)
-    return dict(particles=a.numParticles, yade_step_s=min(ty), direct_step_s=min(td), hook_cost_s=min(ty) - min(td))
-
-
-# The spheres case (issue 12): the dpgk2d_80k scene through O.run, without and with 10⁴ DEM spheres
-# away from the MPM block, registered with yade_mpm.DemSpheres (two-way PTS contact, broad phase).
-# Layouts: "free" — the spheres sit still on a lattice 1 m beside the block, touching nothing (no gravity on
-# them): YADE's own cost is its collider and NewtonIntegrator, so the ratio shows the coupling's cost;
-# "resting" — one row lying on a floor wall under gravity: YADE also runs 10⁴ sphere–wall contacts.
-SPHERES = dict(base="dpgk2d_80k", n=10_000, radius=0.01, steps=200, quick_steps=60, warmup=10, blocks=3,
-               layouts=("free", "resting"))
-
-
-def run_spheres(name, steps, warmup):
-    """Child process: two YADE scenes in this one process (O.switchScene), the same MPM block in each;
-    scene B also holds SPHERES['n'] spheres 1 m beside the block, laid out as `name` ('free' or
-    'resting', see SPHERES), all registered for MPM contact. Interleaved timed blocks; returns the wall
-    seconds per block of each scene."""
-    import yade_mpm as ym
-    from yade import O, utils
-    from yade.wrapper import (ForceResetter, FrictMat, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Wall_Aabb,
-                              InteractionLoop, Ig2_Sphere_Sphere_ScGeom, Ig2_Wall_Sphere_ScGeom,
-                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator)
-    dim, material, cells, _, _ = CASES[SPHERES["base"]]
-    r, n = SPHERES["radius"], SPHERES["n"]
-
-    resting = name == "resting"
-
-    def engines(s, label, bodies):
-        dem = [InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
-               InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                               [Law2_ScGeom_FrictPhys_CundallStrack()])] if bodies else []
-        return [ForceResetter()] + dem + [ym.MpmEngine(s, label=label, bodies=bodies).runner(),
-                                          NewtonIntegrator(gravity=(0, -9.81 if resting else 0.0, 0), damping=0.3)]
-    a = build_scene(dim, material, cells)
-    O.engines = engines(a, "mpmNoSpheres", None)
-    O.dt = 1.0
-    O.run(warmup, True)
-    O.switchScene()
-    b = build_scene(dim, material, cells)
-    x0 = cells[0] * SPACING + 1.0
-    mat = O.materials.append(FrictMat(young=1e8, density=2500.0, frictionAngle=0.5))
-    if resting:
-        O.bodies.append(utils.wall(0.0, axis=1, material=mat))
-    for k in range(n):   # resting: one row on the floor, 0.5 r apart; free: a 100 × 100 lattice, 0.5 r gaps
-        c = (x0 + 2.5 * r * k, r, 0.0) if resting else (x0 + 2.5 * r * (k % 100), 2 * r + 2.5 * r * (k // 100), 0.0)
-        sp = utils.sphere(c, r, material=mat)
-        sp.state.blockedDOFs = "zXY"
-        O.bodies.append(sp)
-    bodies = ym.DemSpheres(b)
-    bodies.add("all", mu=0.0)                 # frictionless, as when this benchmark was recorded
-    O.engines = engines(b, "mpmWithSpheres", bodies)
-    O.dt = 1.0
-    O.run(warmup, True)
-    assert a.lastDt == b.lastDt, "both scenes must step with the MPM stable Δt"
-    O.switchScene()
-    ta, tb = [], []
-    for _ in range(SPHERES["blocks"]):
-        for times in (ta, tb):
-            t0 = time.perf_counter()
-            O.run(steps, True)
-            times.append(time.perf_counter() - t0)
-            O.switchScene()
-    O.switchScene()
-    return dict(layout=name, particles=a.numParticles, spheres=n, steps=steps, wall_without=ta, wall_with=tb,
-                active_spheres=int(bodies.active.sum()), broad_phase_checks=bodies.checks, coupling_python_wall=bodies.wall,
-                steps_with=b.steps, dt=b.lastDt, threads=ym.getThreads())
-
-
-# Contact cost: the uniaxial specimen of paper Sec. 3.3 (cases.uniaxial_flaw, l = 1 mm, rigid-filled flaw:
-# a platen and a free filler in PTS contact) through YADE's loop, beside the same particles without bodies.
-CONTACT_CASE = dict(name="uniaxial_filled_1mm", spacing=1e-3, steps=300, warmup=30)
-
-
-def run_contact(name, steps, warmup):
-    """Child process: O.run of the uniaxial specimen with its platen and filler (mode "contact") or of the
-    same particles without any body ("nocontact")."""
-    from yade import O
-    from yade_mpm_paper import cases
-    bodies = name == "contact"
-    return timed(lambda: cases.uniaxial_flaw("filled", CONTACT_CASE["spacing"], mu_con=0.4, label="mpmcontact",
-                                             with_bodies=bodies)[0], steps, warmup, advance=lambda n: O.run(n, True))[0]
-
-
-def child(args):
-    fn = {"yade": run_yade, "paper": run_paper, "hookprobe": run_hook_probe, "spheres": run_spheres,
-          "contact": run_contact}.get(args.mode, run_direct)
-    res = fn(args.case, args.steps, args.warmup)
-    print("BENCH " + json.dumps(res), flush=True)
 
 
 WAIT_POLICY = None  # OMP_WAIT_POLICY for the children (None: inherit)
@@ -380,7 +141,8 @@ def table(rows, hooks):
     return "\n".join(out)
 
 
-def main():
+def option_parser():
+    """The command line (the hidden --child options run one timed case in this process: bench_scenes.child)."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", help="output directory (summary.json, table.md)")
     ap.add_argument("--cases", default=",".join(CASES), help="comma-separated subset of " + ",".join(CASES))
@@ -403,9 +165,11 @@ def main():
     ap.add_argument("--case", help=argparse.SUPPRESS)
     ap.add_argument("--steps", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--warmup", type=int, help=argparse.SUPPRESS)
-    args = ap.parse_args()
-    if args.child:
-        return child(args)
+    return ap
+
+
+def checked_options(args):
+    """(cases, thread counts, repeats) of the command line; a bad option exits with its message."""
     if not args.out:
         raise SystemExit("--out DIR is required")
     cases = [c for c in args.cases.split(",") if c]
@@ -418,105 +182,126 @@ def main():
     if args.repeats < 1:
         raise SystemExit("--repeats must be >= 1")
     repeats = 1 if args.quick else args.repeats
-    global WAIT_POLICY
-    WAIT_POLICY = None if args.wait_policy == "inherit" else args.wait_policy
-    load_before = os.getloadavg()
-    probe = {n: host_probe(n) for n in (1, 2)}
-    print(f"[bench] host probe: 1 busy process gets {probe[1]:.2f} CPUs, 2 get {probe[2]:.2f} CPUs "
-          f"(idle 2-core host: 1.0 and 2.0); load average {load_before[0]:.1f}", flush=True)
-    os.makedirs(args.out, exist_ok=True)
+    return cases, threads, repeats
+
+
+def timed_cases(cases, threads, repeats, quick):
+    """Every case × thread count, each repeated in fresh child processes: its row (summarise)."""
     rows = []
     jobs = [(c, t) for c in cases for t in threads]
     t_start = time.time()
     for k, (c, t) in enumerate(jobs):
         _, _, _, steps, warm = CASES[c]
-        if args.quick:
+        if quick:
             steps, warm = QUICK_STEPS[c], min(warm, 5)
         runs = [spawn(c, "direct", t, steps, warm) for _ in range(repeats)]
         rows.append(summarise(c, runs))
         r = rows[-1]
         print(f"[bench {k + 1}/{len(jobs)}, {time.time() - t_start:.0f} s] {c} {t}T: {r['particle_steps_per_s'] / 1e6:.2f} M p-steps/s, "
               f"{r['ns_per_particle_step']:.0f} ns/p-step", flush=True)
+    return rows
+
+
+def hook_overhead(cases, threads, repeats, quick, rows):
+    """The YADE hook: O.run against direct stepping of the same scene in paired runs per thread count, then the
+    fixed per-step cost on a tiny scene as a share of a step of the timed case (rows)."""
     hooks = []
-    if not args.no_hook and cases:
-        c = "dpgk2d_80k" if "dpgk2d_80k" in cases else cases[0]
-        _, _, _, steps, warm = CASES[c]
-        if args.quick:
-            steps, warm = QUICK_STEPS[c], 5
-        for t in threads:
-            ratios, cpu_ratios, yr, dr = [], [], [], []
-            for _ in range(repeats):  # paired runs, alternating, so host noise hits both alike
-                d = spawn(c, "direct", t, steps, warm)
-                y = spawn(c, "yade", t, steps, warm)
-                dr.append(d["particles"] * d["steps"] / d["wall"])
-                yr.append(y["particles"] * y["steps"] / y["wall"])
-                ratios.append(y["wall"] / d["wall"] - 1)
-                cpu_ratios.append(y["cpu"] / d["cpu"] - 1)
-            hooks.append(dict(case=c, threads=t, yade_rate=statistics.median(yr), direct_rate=statistics.median(dr),
-                              overhead=statistics.median(ratios), overheads=ratios,
-                              cpu_overhead=statistics.median(cpu_ratios), cpu_overheads=cpu_ratios))
-            print(f"[bench] YADE hook overhead {t}T: wall {100 * hooks[-1]['overhead']:.1f} %, CPU time "
-                  f"{100 * hooks[-1]['cpu_overhead']:.1f} %", flush=True)
-        pr = spawn("tiny", "hookprobe", 1, 1000, 100)
-        step80k = {r["threads"]: r["particles"] / r["particle_steps_per_s"] for r in rows if r["case"] == c}
-        pr["fraction_of_step"] = {t: pr["hook_cost_s"] / st for t, st in step80k.items()}
-        hooks.append(dict(case="hook fixed cost per step", probe=pr))
-        print(f"[bench] YADE hook fixed cost {pr['hook_cost_s'] * 1e6:.0f} µs per step "
-              f"({', '.join(f'{100 * v:.2f} % of a {c} step with {t}T' for t, v in pr['fraction_of_step'].items())})", flush=True)
+    c = "dpgk2d_80k" if "dpgk2d_80k" in cases else cases[0]
+    _, _, _, steps, warm = CASES[c]
+    if quick:
+        steps, warm = QUICK_STEPS[c], 5
+    for t in threads:
+        ratios, cpu_ratios, yr, dr = [], [], [], []
+        for _ in range(repeats):  # paired runs, alternating, so host noise hits both alike
+            d = spawn(c, "direct", t, steps, warm)
+            y = spawn(c, "yade", t, steps, warm)
+            dr.append(d["particles"] * d["steps"] / d["wall"])
+            yr.append(y["particles"] * y["steps"] / y["wall"])
+            ratios.append(y["wall"] / d["wall"] - 1)
+            cpu_ratios.append(y["cpu"] / d["cpu"] - 1)
+        hooks.append(dict(case=c, threads=t, yade_rate=statistics.median(yr), direct_rate=statistics.median(dr),
+                          overhead=statistics.median(ratios), overheads=ratios,
+                          cpu_overhead=statistics.median(cpu_ratios), cpu_overheads=cpu_ratios))
+        print(f"[bench] YADE hook overhead {t}T: wall {100 * hooks[-1]['overhead']:.1f} %, CPU time "
+              f"{100 * hooks[-1]['cpu_overhead']:.1f} %", flush=True)
+    pr = spawn("tiny", "hookprobe", 1, 1000, 100)
+    step80k = {r["threads"]: r["particles"] / r["particle_steps_per_s"] for r in rows if r["case"] == c}
+    pr["fraction_of_step"] = {t: pr["hook_cost_s"] / st for t, st in step80k.items()}
+    hooks.append(dict(case="hook fixed cost per step", probe=pr))
+    print(f"[bench] YADE hook fixed cost {pr['hook_cost_s'] * 1e6:.0f} µs per step "
+          f"({', '.join(f'{100 * v:.2f} % of a {c} step with {t}T' for t, v in pr['fraction_of_step'].items())})", flush=True)
+    return hooks
+
+
+def spheres_cost(threads, quick):
+    """The spheres case (SPHERES): MPM particle-steps/s with and without the DEM spheres, each layout and thread count."""
     spheres = []
-    if args.spheres:
-        for t, layout in [(t, lay) for t in threads for lay in SPHERES["layouts"]]:
-            steps = SPHERES["quick_steps"] if args.quick else SPHERES["steps"]
-            r = spawn(layout, "spheres", t, steps, SPHERES["warmup"])
-            wa, wb = statistics.median(r["wall_without"]), statistics.median(r["wall_with"])
-            row = dict(case=f"{SPHERES['base']} + {r['spheres']} spheres ({layout})", layout=layout, threads=t, particles=r["particles"], spheres=r["spheres"],
-                       rate_without=r["particles"] * steps / wa, rate_with=r["particles"] * steps / wb, ratio=wa / wb,
-                       wall_without=r["wall_without"], wall_with=r["wall_with"], active_spheres=r["active_spheres"],
-                       broad_phase_checks=r["broad_phase_checks"], steps_with=r["steps_with"],
-                       coupling_python_s_per_step=r["coupling_python_wall"] / r["steps_with"],
-                       step_s_with=wb / steps)
-            spheres.append(row)
-            print(f"[bench] spheres ({layout}) {t}T: {row['rate_with'] / 1e6:.2f} M p-steps/s with {r['spheres']} DEM spheres vs "
-                  f"{row['rate_without'] / 1e6:.2f} M without → ratio {row['ratio']:.3f} ({row['active_spheres']} active, "
-                  f"{row['broad_phase_checks']} broad-phase checks in {row['steps_with']} steps; Python side of the coupling "
-                  f"{1e6 * row['coupling_python_s_per_step']:.0f} µs per step = "
-                  f"{100 * row['coupling_python_s_per_step'] / row['step_s_with']:.1f} % of a step)", flush=True)
+    for t, layout in [(t, lay) for t in threads for lay in SPHERES["layouts"]]:
+        steps = SPHERES["quick_steps"] if quick else SPHERES["steps"]
+        r = spawn(layout, "spheres", t, steps, SPHERES["warmup"])
+        wa, wb = statistics.median(r["wall_without"]), statistics.median(r["wall_with"])
+        row = dict(case=f"{SPHERES['base']} + {r['spheres']} spheres ({layout})", layout=layout, threads=t, particles=r["particles"], spheres=r["spheres"],
+                   rate_without=r["particles"] * steps / wa, rate_with=r["particles"] * steps / wb, ratio=wa / wb,
+                   wall_without=r["wall_without"], wall_with=r["wall_with"], active_spheres=r["active_spheres"],
+                   broad_phase_checks=r["broad_phase_checks"], steps_with=r["steps_with"],
+                   coupling_python_s_per_step=r["coupling_python_wall"] / r["steps_with"],
+                   step_s_with=wb / steps)
+        spheres.append(row)
+        print(f"[bench] spheres ({layout}) {t}T: {row['rate_with'] / 1e6:.2f} M p-steps/s with {r['spheres']} DEM spheres vs "
+              f"{row['rate_without'] / 1e6:.2f} M without → ratio {row['ratio']:.3f} ({row['active_spheres']} active, "
+              f"{row['broad_phase_checks']} broad-phase checks in {row['steps_with']} steps; Python side of the coupling "
+              f"{1e6 * row['coupling_python_s_per_step']:.0f} µs per step = "
+              f"{100 * row['coupling_python_s_per_step'] / row['step_s_with']:.1f} % of a step)", flush=True)
+    return spheres
+
+
+def contact_cost(threads, repeats, quick):
+    """The contact case (CONTACT_CASE): with its platen and filler against the same particles without bodies, paired runs."""
     contact = []
-    if not args.no_contact:
-        steps, warm = (50, 5) if args.quick else (CONTACT_CASE["steps"], CONTACT_CASE["warmup"])
-        for t in threads:
-            with_b, without = [], []
-            for _ in range(repeats):  # paired, alternating runs: host noise hits both alike
-                w = spawn("contact", "contact", t, steps, warm)
-                n = spawn("nocontact", "contact", t, steps, warm)
-                with_b.append(w["particles"] * w["steps"] / w["wall"])
-                without.append(n["particles"] * n["steps"] / n["wall"])
-            ratio = statistics.median([a / b for a, b in zip(with_b, without)])
-            contact.append(dict(case=CONTACT_CASE["name"], threads=t, particles=w["particles"], with_bodies_rate=statistics.median(with_b),
-                                without_bodies_rate=statistics.median(without), ratio=ratio, ratios=[a / b for a, b in zip(with_b, without)],
-                                contact_phase_s_per_step=w["phases"].get("contact", float("nan")) / w["steps"]))
-            print(f"[bench] contact {CONTACT_CASE['name']} {t}T: {statistics.median(with_b) / 1e6:.2f} vs {statistics.median(without) / 1e6:.2f} "
-                  f"M p-steps/s without bodies: ratio {ratio:.3f} (bar ≥ 0.70)", flush=True)
+    steps, warm = (50, 5) if quick else (CONTACT_CASE["steps"], CONTACT_CASE["warmup"])
+    for t in threads:
+        with_b, without = [], []
+        for _ in range(repeats):  # paired, alternating runs: host noise hits both alike
+            w = spawn("contact", "contact", t, steps, warm)
+            n = spawn("nocontact", "contact", t, steps, warm)
+            with_b.append(w["particles"] * w["steps"] / w["wall"])
+            without.append(n["particles"] * n["steps"] / n["wall"])
+        ratio = statistics.median([a / b for a, b in zip(with_b, without)])
+        contact.append(dict(case=CONTACT_CASE["name"], threads=t, particles=w["particles"], with_bodies_rate=statistics.median(with_b),
+                            without_bodies_rate=statistics.median(without), ratio=ratio, ratios=[a / b for a, b in zip(with_b, without)],
+                            contact_phase_s_per_step=w["phases"].get("contact", float("nan")) / w["steps"]))
+        print(f"[bench] contact {CONTACT_CASE['name']} {t}T: {statistics.median(with_b) / 1e6:.2f} vs {statistics.median(without) / 1e6:.2f} "
+              f"M p-steps/s without bodies: ratio {ratio:.3f} (bar ≥ 0.70)", flush=True)
+    return contact
+
+
+def paper_scale(threads, repeats, quick, out):
+    """The paper-scale scenes (PAPER) timed for a few hundred steps, their full wall time extrapolated (penny: also at C = 1);
+    the tunnel also against the ceiling kernel's DP rate (kernel_bound)."""
     paper = []
-    if args.paper:
-        for name, cfg in PAPER.items():
-            steps, warm = (cfg["steps"] // 3, 10) if args.quick else (cfg["steps"], cfg["warmup"])
-            t = max(threads)
-            r = spawn(name, "paper", t, steps, warm)
-            rate = r["particles"] * r["steps"] / r["wall"]
-            nsteps = cfg["end_time"] / r["dt"]
-            for courant, n in [(r["courant"], nsteps)] + ([(1.0, nsteps * r["courant"])] if name.startswith("penny") else []):
-                paper.append(dict(case=name, particles=r["particles"], threads=t, dt=r["dt"] * courant / r["courant"], courant=courant,
-                                  end_time=cfg["end_time"], steps_needed=n, particle_steps_per_s=rate,
-                                  particle_steps_per_cpu_s=r["particles"] * r["steps"] / r["cpu"],
-                                  extrapolated_wall_s=n * r["particles"] / rate, measured_steps=r["steps"],
-                                  plastic_fraction=r.get("plastic_fraction"), damaged_fraction=r.get("damaged_fraction")))
-                wall = n * r["particles"] / rate
-                bar = f"; issue 19 bar ≤ 300 s: {'met' if wall <= 300 else 'not met'}" if name.startswith("tunnel") else ""
-                print(f"[bench] {name} ({r['particles']:,} particles, {t}T, C = {courant}): {rate / 1e6:.2f} M p-steps/s, "
-                      f"{n:,.0f} steps → {wall:.0f} s = {wall / 60:.1f} min (extrapolated){bar}", flush=True)
-            if name.startswith("tunnel"):
-                paper[-1].update(kernel_bound(paper[-1], t, args.out, repeats))
+    for name, cfg in PAPER.items():
+        steps, warm = (cfg["steps"] // 3, 10) if quick else (cfg["steps"], cfg["warmup"])
+        t = max(threads)
+        r = spawn(name, "paper", t, steps, warm)
+        rate = r["particles"] * r["steps"] / r["wall"]
+        nsteps = cfg["end_time"] / r["dt"]
+        for courant, n in [(r["courant"], nsteps)] + ([(1.0, nsteps * r["courant"])] if name.startswith("penny") else []):
+            paper.append(dict(case=name, particles=r["particles"], threads=t, dt=r["dt"] * courant / r["courant"], courant=courant,
+                              end_time=cfg["end_time"], steps_needed=n, particle_steps_per_s=rate,
+                              particle_steps_per_cpu_s=r["particles"] * r["steps"] / r["cpu"],
+                              extrapolated_wall_s=n * r["particles"] / rate, measured_steps=r["steps"],
+                              plastic_fraction=r.get("plastic_fraction"), damaged_fraction=r.get("damaged_fraction")))
+            wall = n * r["particles"] / rate
+            bar = f"; issue 19 bar ≤ 300 s: {'met' if wall <= 300 else 'not met'}" if name.startswith("tunnel") else ""
+            print(f"[bench] {name} ({r['particles']:,} particles, {t}T, C = {courant}): {rate / 1e6:.2f} M p-steps/s, "
+                  f"{n:,.0f} steps → {wall:.0f} s = {wall / 60:.1f} min (extrapolated){bar}", flush=True)
+        if name.startswith("tunnel"):
+            paper[-1].update(kernel_bound(paper[-1], t, out, repeats))
+    return paper
+
+
+def write_outputs(out, rows, hooks, contact, paper, spheres, load_before, probe):
+    """DIR/summary.json and DIR/table.md (printed too)."""
     summary = dict(cases=rows, hook=hooks, contact=contact, paper=paper, spheres=spheres, spacing=SPACING, ppc=2, host=os.uname().nodename, cpu_count=os.cpu_count(),
                    date=time.strftime("%Y-%m-%d %H:%M:%S"), omp_wait_policy=WAIT_POLICY or os.environ.get("OMP_WAIT_POLICY"),
                    gomp_spincount=os.environ.get("GOMP_SPINCOUNT", "10000 (yade_mpm default)"),
@@ -524,7 +309,7 @@ def main():
                    cpus_available_1_process=probe[1], cpus_available_2_processes=probe[2],
                    note="load average > 0 before the run means other processes shared the 2 cores (wall rates are then low "
                         "and noisy, 2-thread rates most)")
-    with open(os.path.join(args.out, "summary.json"), "w") as f:
+    with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump(summary, f, indent=1)
     tab = table(rows, hooks)
     tab += (f"\n- Host during the run: load average {load_before[0]:.1f} before, {os.getloadavg()[0]:.1f} after; a busy "
@@ -541,9 +326,29 @@ def main():
                           f"{p['steps_needed']:,.0f} | {p['particle_steps_per_s'] / 1e6:.2f} | {p['extrapolated_wall_s']:.0f} s ({p['extrapolated_wall_s'] / 60:.1f} min) | "
                           + (f"{p['kernel_bound_wall_s']:.0f} s ({p['kernel_dp_rate'] / 1e6:.2f} M p-steps/s) |" if "kernel_bound_wall_s" in p else "– |")
                           for p in paper)
-    with open(os.path.join(args.out, "table.md"), "w") as f:
+    with open(os.path.join(out, "table.md"), "w") as f:
         f.write(tab + "\n")
     print(tab)
+
+
+def main():
+    args = option_parser().parse_args()
+    if args.child:
+        return child(args)
+    cases, threads, repeats = checked_options(args)
+    global WAIT_POLICY
+    WAIT_POLICY = None if args.wait_policy == "inherit" else args.wait_policy
+    load_before = os.getloadavg()
+    probe = {n: host_probe(n) for n in (1, 2)}
+    print(f"[bench] host probe: 1 busy process gets {probe[1]:.2f} CPUs, 2 get {probe[2]:.2f} CPUs "
+          f"(idle 2-core host: 1.0 and 2.0); load average {load_before[0]:.1f}", flush=True)
+    os.makedirs(args.out, exist_ok=True)
+    rows = timed_cases(cases, threads, repeats, args.quick)
+    hooks = hook_overhead(cases, threads, repeats, args.quick, rows) if not args.no_hook and cases else []
+    spheres = spheres_cost(threads, args.quick) if args.spheres else []
+    contact = contact_cost(threads, repeats, args.quick) if not args.no_contact else []
+    paper = paper_scale(threads, repeats, args.quick, args.out) if args.paper else []
+    write_outputs(args.out, rows, hooks, contact, paper, spheres, load_before, probe)
 
 
 if __name__ == "__main__":

@@ -93,7 +93,7 @@ def run_one(case, build, threads):
         cmd = [sys.executable, "-c", code]
     else:
         sys.path.insert(0, HERE)
-        from bench import CASES                                   # timed and warm-up steps of the case
+        from bench_scenes import CASES                            # timed and warm-up steps of the case
         cmd = [sys.executable, benchpy, "--child", "--mode", "direct", "--case", case, "--steps", str(CASES[case][3]),
                "--warmup", str(CASES[case][4])]
     r = subprocess.run(cmd, env=env, capture_output=True, text=True)

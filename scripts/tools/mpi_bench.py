@@ -6,7 +6,8 @@ slip side walls, initial pure-shear velocity) on 1 process or N MPI ranks (doc/d
 
 Every rank prints one JSON line (rank, particles, seconds per step, phase times per step); the ranks
 step in lock-step (two shared-node exchanges and one reduction per step), so rank 0's time is the
-step time. Timings on a loaded host are labelled as such in doc/developer/scaling.md."""
+step time. Timings on a loaded host are labelled as such in doc/developer/scaling.md. (The benchmark's scenes
+live beside it in scripts/tools/bench_scenes.py.)"""
 import argparse
 import json
 import os
@@ -27,7 +28,7 @@ def main():
         ap.error(f"--cells = {a.cells} must be 2 or 3 integers ≥ 1")
     if a.steps < 1 or a.warmup < 0:
         ap.error("--steps must be ≥ 1 and --warmup ≥ 0")
-    from bench import build_scene
+    from bench_scenes import build_scene
     import yade_mpm as ym
     s = build_scene(len(a.cells), a.material, tuple(a.cells))
     n_total = s.numParticles
