@@ -87,7 +87,7 @@ def test_free_box_turning_in_a_slot():
     (0.1899 rad), and comes back."""
     from yade import O, utils, Vector3
     from yade.wrapper import FrictMat
-    from test_contact import _yade_scene
+    from test_contact_yade import _yade_scene
     O.reset()
     l, w0 = 0.02, 3.0
     s = ym.make_solver((0, 0), (0.5, 0.4), l)

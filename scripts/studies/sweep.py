@@ -177,6 +177,122 @@ def open_client(a):
     return Client(cl), cl, f"LocalCluster {cl.scheduler_address}: {n} workers"
 
 
+def line_command(a, script):
+    """The command every table line runs (`yade -n -x SCRIPT` or `python SCRIPT`) and its environment: OpenMP
+    threads per run, no display, this process's PYTHONPATH passed on."""
+    if a.runner == "yade":
+        command = ["yade", f"--threads={a.threads_per_run}", "-n", "-x", script]
+    else:
+        command = ["python", script]
+    env = {"OMP_NUM_THREADS": str(a.threads_per_run), "DISPLAY": ""}
+    if os.environ.get("PYTHONPATH"):
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
+    return command, env
+
+
+class Sweep:
+    """The lines still to run, handed to the Dask workers one per free worker thread, and what became of them:
+    finished, failed (line -> message) or interrupted. The running lines stop through the Dask Event `ev`."""
+
+    def __init__(self, a, client, slots, table, info, todo, command, env, stop, n_chosen, n_done):
+        from distributed import Event
+        self.a, self.client, self.slots, self.table, self.info = a, client, slots, table, info
+        self.command, self.env, self.stop, self.n_chosen, self.n_done = command, env, stop, n_chosen, n_done
+        self.token = uuid.uuid4().hex[:8]
+        self.ev = Event(f"sweep-stop-{self.token}", client=client)
+        self.futs, self.queue, self.pending = {}, list(todo), set()
+        self.t0, self.last, self.walls = time.time(), 0.0, []
+        self.failed, self.finished, self.interrupted = {}, [], []
+
+    def submit(self):
+        """Keep one line per worker thread in flight: a line is handed to a worker only when one is free, so
+        a worker that dies takes only the line it was running with it (and workers may join or leave)."""
+        self.slots = sum(self.client.nthreads().values())
+        while self.queue and len(self.pending) < max(self.slots, 1) and not self.stop.requested:
+            ln = self.queue.pop(0)
+            f = self.client.submit(run_line, ln, self.command, dict(self.env, YADE_BATCH=f"{self.table}:{ln}"), os.getcwd(),
+                                   self.info[ln][1], self.a.line_timeout, self.ev.name, key=f"sweep-{self.token}-line{ln}", pure=False)
+            self.futs[f] = ln
+            self.pending.add(f)
+
+    def progress(self, force=False):
+        """A progress line (done, running, failed, waiting, ETA) every --progress seconds, or now (force)."""
+        now = time.time()
+        if not force and now - self.last < self.a.progress:
+            return
+        self.last = now
+        mean = sum(self.walls) / len(self.walls) if self.walls else None
+        eta = mean * (len(self.queue) + 0.5 * len(self.pending)) / max(self.slots, 1) if mean else None
+        print(f"[sweep] {self.n_done + len(self.finished)}/{self.n_chosen} done, {len(self.pending)} running, {len(self.failed)} failed, "
+              f"{len(self.queue)} waiting; elapsed {fmt_s(now - self.t0)}, ETA {fmt_s(eta)}", flush=True)
+
+    def collect(self, f):
+        """A line whose task ended: finished (its summary.csv written), interrupted by the sweep, or failed (its
+        error.txt says why: exit status, timeout or the worker that died, with the last lines of its log)."""
+        self.pending.discard(f)
+        ln = self.futs.pop(f)                        # forget it: Dask would rerun a line whose result a dead worker held
+        desc, run_dir = self.info[ln]
+        if f.status == "finished":
+            r = f.result()
+            self.walls.append(r["wall"])
+            if r["rc"] == 0 and os.path.exists(os.path.join(run_dir, batch.SUMMARY)):
+                self.finished.append(ln)
+                print(f"[sweep] line {ln} ({desc}) done in {fmt_s(r['wall'])} on {r['host']}", flush=True)
+                return
+            if r["reason"] and r["reason"].startswith("stopped by the sweep"):
+                self.interrupted.append(ln)
+                record_failure(run_dir, f"interrupted: {r['reason']}", replace=True)
+                return
+            msg = record_failure(run_dir, f"{r['reason'] or 'exit status %d' % r['rc']} on {r['host']}; last lines of the log:\n"
+                                 + log_tail(run_dir))
+        else:                                   # the task itself failed: its worker died (KilledWorker), …
+            exc = f.exception()
+            msg = record_failure(run_dir, f"{type(exc).__name__}: the worker running this line died or failed ({exc}); "
+                                 "last lines of the log:\n" + log_tail(run_dir))
+        self.failed[ln] = msg
+        print(f"[sweep] line {ln} ({desc}) FAILED: {msg.splitlines()[0]} (log: {os.path.join(run_dir, 'log.txt')})", flush=True)
+
+    def run(self):
+        """Until every line has ended (or, after a stop request, every running line has)."""
+        from distributed import wait
+        self.submit()
+        while self.pending or (self.queue and not self.stop.requested):
+            if self.stop.requested and not self.ev.is_set():     # the running lines stop through the Event
+                self.ev.set()
+            try:
+                finished_now = wait(list(self.pending), timeout=1.0, return_when="FIRST_COMPLETED").done if self.pending else ()
+            except TimeoutError:
+                finished_now = ()
+            if not self.pending:
+                time.sleep(1.0)                         # no worker yet (a cluster still starting)
+            for f in finished_now:
+                self.collect(f)
+            for f in finished_now:
+                f.release()
+            self.submit()
+            self.progress(force=bool(finished_now))
+
+
+def run_lines(a, table, script, info, todo, n_chosen, n_done):
+    """The lines `todo` on a cluster (open_client), Ctrl-C handled (Stop); returns (failed, finished, interrupted)."""
+    stop = Stop()
+    client, cluster, where = open_client(a)
+    slots = sum(client.nthreads().values()) or 1
+    print(f"[sweep] {where}, {slots} runs at a time, {a.threads_per_run} thread(s) per run, runner {a.runner}", flush=True)
+    command, env = line_command(a, script)
+    sweep = Sweep(a, client, slots, table, info, todo, command, env, stop, n_chosen, n_done)
+    try:
+        sweep.run()
+    except KeyboardInterrupt:
+        print("[sweep] quitting at once", flush=True)
+    finally:
+        sweep.interrupted += [sweep.futs[f] for f in sweep.pending] + sweep.queue
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return sweep.failed, sweep.finished, sweep.interrupted
+
+
 def main(argv=None):
     a = parse(argv)
     table, script = os.path.abspath(a.table), os.path.abspath(a.script)
@@ -186,92 +302,7 @@ def main(argv=None):
     done = [ln for ln in chosen if os.path.exists(os.path.join(info[ln][1], batch.SUMMARY))]
     todo = [ln for ln in chosen if ln not in done]
     print(f"[sweep] {a.table}: {len(chosen)} lines, {len(done)} done earlier (skipped), {len(todo)} to run", flush=True)
-    failed, finished, interrupted = {}, [], []
-    if todo:
-        stop = Stop()
-        client, cluster, where = open_client(a)
-        slots = sum(client.nthreads().values()) or 1
-        print(f"[sweep] {where}, {slots} runs at a time, {a.threads_per_run} thread(s) per run, runner {a.runner}", flush=True)
-        from distributed import Event, wait
-        token = uuid.uuid4().hex[:8]
-        ev = Event(f"sweep-stop-{token}", client=client)
-        if a.runner == "yade":
-            command = ["yade", f"--threads={a.threads_per_run}", "-n", "-x", script]
-        else:
-            command = ["python", script]
-        env = {"OMP_NUM_THREADS": str(a.threads_per_run), "DISPLAY": ""}
-        if os.environ.get("PYTHONPATH"):
-            env["PYTHONPATH"] = os.environ["PYTHONPATH"]
-        futs, queue, pending = {}, list(todo), set()
-        t0, last, walls = time.time(), 0.0, []
-
-        def submit():
-            """Keep one line per worker thread in flight: a line is handed to a worker only when one is free, so
-            a worker that dies takes only the line it was running with it (and workers may join or leave)."""
-            nonlocal slots
-            slots = sum(client.nthreads().values())
-            while queue and len(pending) < max(slots, 1) and not stop.requested:
-                ln = queue.pop(0)
-                f = client.submit(run_line, ln, command, dict(env, YADE_BATCH=f"{table}:{ln}"), os.getcwd(), info[ln][1],
-                                  a.line_timeout, ev.name, key=f"sweep-{token}-line{ln}", pure=False)
-                futs[f] = ln
-                pending.add(f)
-
-        def progress(force=False):
-            nonlocal last
-            now = time.time()
-            if not force and now - last < a.progress:
-                return
-            last = now
-            mean = sum(walls) / len(walls) if walls else None
-            eta = mean * (len(queue) + 0.5 * len(pending)) / max(slots, 1) if mean else None
-            print(f"[sweep] {len(done) + len(finished)}/{len(chosen)} done, {len(pending)} running, {len(failed)} failed, "
-                  f"{len(queue)} waiting; elapsed {fmt_s(now - t0)}, ETA {fmt_s(eta)}", flush=True)
-        try:
-            submit()
-            while pending or (queue and not stop.requested):
-                if stop.requested and not ev.is_set():     # the running lines stop through the Event
-                    ev.set()
-                try:
-                    finished_now = wait(list(pending), timeout=1.0, return_when="FIRST_COMPLETED").done if pending else ()
-                except TimeoutError:
-                    finished_now = ()
-                if not pending:
-                    time.sleep(1.0)                         # no worker yet (a cluster still starting)
-                for f in finished_now:
-                    pending.discard(f)
-                    ln = futs.pop(f)                        # forget it: Dask would rerun a line whose result a dead worker held
-                    desc, run_dir = info[ln]
-                    if f.status == "finished":
-                        r = f.result()
-                        walls.append(r["wall"])
-                        if r["rc"] == 0 and os.path.exists(os.path.join(run_dir, batch.SUMMARY)):
-                            finished.append(ln)
-                            print(f"[sweep] line {ln} ({desc}) done in {fmt_s(r['wall'])} on {r['host']}", flush=True)
-                            continue
-                        if r["reason"] and r["reason"].startswith("stopped by the sweep"):
-                            interrupted.append(ln)
-                            record_failure(run_dir, f"interrupted: {r['reason']}", replace=True)
-                            continue
-                        msg = record_failure(run_dir, f"{r['reason'] or 'exit status %d' % r['rc']} on {r['host']}; last lines of the log:\n"
-                                             + log_tail(run_dir))
-                    else:                                   # the task itself failed: its worker died (KilledWorker), …
-                        exc = f.exception()
-                        msg = record_failure(run_dir, f"{type(exc).__name__}: the worker running this line died or failed ({exc}); "
-                                             "last lines of the log:\n" + log_tail(run_dir))
-                    failed[ln] = msg
-                    print(f"[sweep] line {ln} ({desc}) FAILED: {msg.splitlines()[0]} (log: {os.path.join(run_dir, 'log.txt')})", flush=True)
-                for f in finished_now:
-                    f.release()
-                submit()
-                progress(force=bool(finished_now))
-        except KeyboardInterrupt:
-            print("[sweep] quitting at once", flush=True)
-        finally:
-            interrupted += [futs[f] for f in pending] + queue
-            client.close()
-            if cluster is not None:
-                cluster.close()
+    failed, finished, interrupted = run_lines(a, table, script, info, todo, len(chosen), len(done)) if todo else ({}, [], [])
     missing = len(chosen) - len(done) - len(finished)
     print(f"[sweep] {len(done) + len(finished)}/{len(chosen)} lines done ({len(finished)} now), {len(failed)} failed, "
           f"{len(set(interrupted))} interrupted" + (f"; run the same command again to complete the {missing} missing" if missing else ""),
