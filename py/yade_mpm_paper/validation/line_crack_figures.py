@@ -11,6 +11,13 @@ from yade_mpm_paper.validation import sneddon
 from yade_mpm_paper.validation.line_crack import PAPER_CELL, PAPER_DA
 
 
+def _save(plt, fig, path):
+    """A figure laid out tight, written at 150 dpi and closed."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
 def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
     """Damage on the particles' initial lattice (one pixel per particle; the hole is white)."""
     plt = out.pyplot()
@@ -27,9 +34,7 @@ def damage_png(s, geo, path, title, half_width=2.0, half_height=0.6):
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    _save(plt, fig, path)
 
 
 def plot_elastic(e, outdir, P, half_crack, rock):
@@ -53,9 +58,7 @@ def plot_elastic(e, outdir, P, half_crack, rock):
     ax[1].set_xlabel("|x − x_c| [m]")
     ax[1].set_ylabel("σ [MPa]")
     ax[1].legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "elastic_profiles.png"), dpi=150)
-    plt.close(fig)
+    _save(plt, fig, os.path.join(outdir, "elastic_profiles.png"))
 
 
 def plot_convergence(conv, outdir):
@@ -70,9 +73,7 @@ def plot_convergence(conv, outdir):
     ax.set_xlabel("wall time [s]")
     ax.set_ylabel("relative error")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "error_vs_walltime.png"), dpi=150)
-    plt.close(fig)
+    _save(plt, fig, os.path.join(outdir, "error_vs_walltime.png"))
 
 
 def plot_da(results, outdir):
@@ -88,7 +89,5 @@ def plot_da(results, outdir):
     ax.set_xlabel("t (paper time scale) [s]")
     ax.set_ylabel("Δa [cells of 0.02 m]")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "crack_extension.png"), dpi=150)
-    plt.close(fig)
+    _save(plt, fig, os.path.join(outdir, "crack_extension.png"))
 
