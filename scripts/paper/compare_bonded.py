@@ -49,8 +49,11 @@ import yade_mpm as ym
 from yade_mpm.fields import id_order
 from yade_mpm import rocks
 from yade_mpm_paper import cases
-from yade_mpm_paper.validation import bonded, bonded_figures
+from yade_mpm_paper.validation import bonded
 from yade_mpm import output as out
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare_bonded_figures as figures  # noqa: E402  (the sibling module: this script's figures and curve files)
 
 MPa, GPa = 1e6, 1e9
 SAND = rocks.MIAO2018_SANDSTONE
@@ -239,7 +242,7 @@ def uniaxial_part(a, summary):
     results["open_flaw"] = dict(mpm=mpm_fl, jcfpm=dem_fl)
     for case, r in results.items():
         for meth, q in r.items():
-            bonded_figures.write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
+            figures.write_curve(os.path.join(a.out, f"curves_{case}_{meth}.csv"), q["strain"], q["stress"])
             summary.setdefault(case, {})[meth] = dict(youngs_modulus_GPa=q["youngs_modulus"] / GPa,
                                                       peak_stress_MPa=q["peak_stress"] / MPa,
                                                       particles=int(q["particles"]), wall_time_s=q["wall_time_s"],
@@ -253,13 +256,13 @@ def uniaxial_part(a, summary):
         for h in (holes if case == "open_flaw" else ()):
             keep &= ~bonded.overlapping(h, P[:, :2], P[:, 2])
         r["jcfpm"]["discs"] = P[keep]
-        bonded_figures.plot_cracks(os.path.join(a.out, f"cracks_{case}.png"), r["mpm"], r["jcfpm"], holes if case == "open_flaw" else [],
-                                   f"{case.replace('_', ' ')}: end of the run (MPM ε = {100 * r['mpm']['strain'][-1]:.2f} %, "
-                                   f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
+        figures.plot_cracks(os.path.join(a.out, f"cracks_{case}.png"), r["mpm"], r["jcfpm"], holes if case == "open_flaw" else [],
+                            f"{case.replace('_', ' ')}: end of the run (MPM ε = {100 * r['mpm']['strain'][-1]:.2f} %, "
+                            f"JCFpm ε = {100 * r['jcfpm']['strain'][-1]:.2f} %)")
         for meth in ("jcfpm",):
             q = r[meth]
             summary[case][meth].update(tensile_cracks=q["tensile_cracks"], shear_cracks=q["shear_cracks"], bonds=q["bonds"])
-    bonded_figures.plot_curves(os.path.join(a.out, "stress_strain.png"), results)
+    figures.plot_curves(os.path.join(a.out, "stress_strain.png"), results)
     summary["calibration"] = dict(procedure="fixed-point scaling: young *= E_mpm/E, tensile and cohesion *= peak_mpm/peak; "
                                             f"ks/kn = {KS_KN}, cohesion/tensile = {COH_OVER_TENS}, friction = {FRICTION_DEG:.1f} deg",
                                   runs=rows, wall_time_s=t_cal, micro=micro.as_dict(), packing_wall_time_s=t_pack,
@@ -314,7 +317,7 @@ def kirsch_part(a, summary):
     summary["kirsch_setup"] = dict(domain_m=L, hole_radius_m=cases.OPENING_RADIUS, far_field_MPa=[cases.OPENING_SXX / MPa,
                                    cases.OPENING_SYY / MPa], jcfpm_window_radius_m=0.5 * cases.OPENING_RADIUS,
                                    time="cpu_time_s: CPU seconds of the one-thread run; wall_time_s depends on the host load")
-    bonded_figures.plot_kirsch_error_vs_time(os.path.join(a.out, "kirsch_error_vs_time.png"), rows, L, cases.OPENING_RADIUS)
+    figures.plot_kirsch_error_vs_time(os.path.join(a.out, "kirsch_error_vs_time.png"), rows, L, cases.OPENING_RADIUS)
 
 
 def main(argv=None):

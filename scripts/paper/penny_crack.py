@@ -35,11 +35,14 @@ import numpy as np
 
 import yade_mpm as ym
 import yade_mpm.output as out
-from yade_mpm_paper.validation import line_crack_figures, sneddon
+from yade_mpm_paper.validation import sneddon
 from yade_mpm_paper.validation.line_crack import PAPER_DA, crack_extension, elastic_profiles, face_opening, interp_da, paper_comparison
 
 from yade_mpm import rocks, runner
 from yade_mpm_paper import batch, cases
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import penny_crack_figures as figures  # noqa: E402  (the sibling module: this script's figures)
 
 ROCK = rocks.GRANITE                   # paper Sec. 3.2 rock (elastic part), DP–GK: rocks.GRANITE_DPGK
 HALF_CRACK = cases.CRACK_HALF_LENGTH   # c [m]
@@ -121,8 +124,8 @@ def run_damage(args, law, outdir):
     def snapshot(tp):
         def write(s):
             tag = f"{law}_t{tp:.2f}s"
-            line_crack_figures.damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
-                       f"D, growth law {law}, t_paper = {tp} s (P = {args.damage_pressure * tp / PAPER_RAMP / 1e6:.0f} MPa)")
+            figures.damage_png(s, geo, os.path.join(outdir, f"damage_{tag}.png"),
+                               f"D, growth law {law}, t_paper = {tp} s (P = {args.damage_pressure * tp / PAPER_RAMP / 1e6:.0f} MPa)")
             if args.vtu:
                 out.write_particles(os.path.join(outdir, f"damage_{tag}.vtu"), s)
         return runner.Output(write, times=[tp / scale])
@@ -250,7 +253,7 @@ def elastic_part(a, stopped, summary):
     write_uy(os.path.join(a.out, "elastic_uy.csv"), e)
     out.write_csv(os.path.join(a.out, "elastic_stress_ahead.csv"), ["abs_x_minus_xc_m", "syy_mpm_Pa", "sxx_mpm_Pa", "s_eq44_Pa"],
                   zip(e["xs"], e["syy"], e["sxx"], e["sa"]))
-    line_crack_figures.plot_elastic(e, a.out, a.elastic_pressure, HALF_CRACK, ROCK)
+    figures.plot_elastic(e, a.out, a.elastic_pressure, HALF_CRACK, ROCK)
     summary.update(uy_center_rel_error=e["uy_centre_err"], uy_l2_rel_error=e["uy_l2"],
                    syy_ahead_l2_rel_error=e["syy_l2_far"], elastic_wall_time_s=e["wall"],
                    elastic_particles=e["particles"], elastic_steps=e["steps"], elastic_time_s=e["t"],
@@ -275,7 +278,7 @@ def convergence_part(a, parts, e, stopped, summary):
                   ["spacing_m", "particles", "steps", "wall_s", "uy_center_rel_error", "uy_l2_rel_error", "syy_ahead_l2_rel_error"],
                   [(c["h"], c["particles"], c["steps"], c["wall"], c["uy_centre_err"], c["uy_l2"], c["syy_l2_far"]) for c in conv])
     if conv:
-        line_crack_figures.plot_convergence(conv, a.out)
+        figures.plot_convergence(conv, a.out)
     summary["convergence"] = [dict(spacing_m=c["h"], particles=c["particles"], wall_time_s=c["wall"],
                                    uy_center_rel_error=c["uy_centre_err"], uy_l2_rel_error=c["uy_l2"]) for c in conv]
 
@@ -300,7 +303,7 @@ def damage_part(a, stopped, summary):
         print(f"damage law {law}: " + ", ".join(f"t={d['t_s']}: {d['left']}/{d['right']}" for d in table)
               + f"; plastic {r['plastic']} (not cracked {r['plastic_intact']}); wall {r['wall']:.0f} s", flush=True)
     if results:
-        line_crack_figures.plot_da(results, a.out)
+        figures.plot_da(results, a.out)
         first = summary[f"damage_{results[0]['law']}"]
         summary["default_law"] = results[0]["law"]
         summary["crack_extension_cells"] = first["crack_extension_cells"]

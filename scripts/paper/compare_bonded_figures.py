@@ -1,5 +1,5 @@
-"""The figures and curve files of scripts/paper/compare_bonded.py (yade-mpm beside YADE's bonded-particle
-model JCFpm, doc/validation/mpm_vs_bonded.md): stress–strain curves of both methods, the end-of-run cracks of each
+"""The figures and curve files of compare_bonded.py beside it (yade-mpm beside YADE's bonded-particle model
+JCFpm, doc/validation/mpm_vs_bonded.md): stress–strain curves of both methods, the end-of-run cracks of each
 uniaxial specimen and the Kirsch stress error against run time."""
 import csv
 

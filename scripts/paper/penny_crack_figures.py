@@ -1,4 +1,4 @@
-"""The figures of scripts/paper/penny_crack.py (the pressurised line crack, paper Sec. 3.2, Figs. 7–9):
+"""The figures of penny_crack.py beside it (the pressurised line crack, paper Sec. 3.2, Figs. 7–9):
 the damage field on the particles' initial lattice, the elastic opening and the stress ahead of the tip
 against Sneddon, the error against wall time of the convergence runs, the crack extension against Fig. 9."""
 import os
