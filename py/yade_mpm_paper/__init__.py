@@ -6,5 +6,6 @@ reference scripts under scripts/paper/ import both.
     cases        scene builders of the reference cases (circular opening, line crack, uniaxial flaw, tunnel)
     validation   analytic references (Kirsch, Sneddon) and the suites that compare the solver with them
     fidelity     the measures of the paper's figures and the fidelity table built from a run's summaries
+    report       the validation report's document and sections (scripts/paper/report.py puts them in order)
     batch        the glue that runs a reference script as a yade-batch job or a Dask sweep line
 """
