@@ -19,8 +19,9 @@ TOPICS = {
               "test_report", "test_scripts_smoke", "test_slab3d", "test_stability", "test_studies", "test_tunnel", "test_tunnel_script"],
     "mpi": ["test_mpi", "test_mpi_checkpoint", "test_mpi_contact", "test_mpi_outside", "test_mpi_rebalance", "test_mpi_spheres"],
 }
-SLOW = {"test_contact_matrix", "test_studies", "test_scripts_smoke", "test_tunnel_script", "test_penny_prism", "test_slab3d",
-        "test_mpi_spheres", "test_mpi_contact", "test_bonded", "test_stability", "test_report", "test_hybrid"}
+SLOW = {"test_contact_matrix", "test_studies", "test_contact_params", "test_scripts_smoke", "test_contact_kinematic",
+        "test_contact_corners", "test_tunnel_script", "test_mpi_contact", "test_slab3d", "test_mpi_spheres", "test_circular_opening",
+        "test_penny_prism", "test_examples"}
 _TOPIC_OF = {f: t for t, files in TOPICS.items() for f in files}
 
 
@@ -28,7 +29,7 @@ def pytest_configure(config):
     for name, text in (("unit", "API, input checks and layout: no physics run longer than a few steps"),
                        ("physics", "the solver against analytic solutions, conservation laws and independent calculations"),
                        ("paper", "the paper's reference cases, their scripts and the validation report"),
-                       ("mpi", "N MPI ranks against one process"), ("slow", "the longest files (about 80 % of the suite's time)"),
+                       ("mpi", "N MPI ranks against one process"), ("slow", "the longest files (about 85 % of the suite's time)"),
                        ("quick", "the daily subset: every file not marked slow")):
         config.addinivalue_line("markers", f"{name}: {text}")
 
