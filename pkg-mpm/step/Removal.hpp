@@ -3,8 +3,8 @@
 // that tells debris from the body (BodyClusters). Everything here runs only on the rare steps where a
 // particle left the grid; a step where none leaves pays one check of an empty list.
 #pragma once
-#include "Grid.hpp"
-#include "Particles.hpp"
+#include "../core/Grid.hpp"
+#include "../core/Particles.hpp"
 #include <algorithm>
 #include <vector>
 

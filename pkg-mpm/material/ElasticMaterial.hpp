@@ -2,7 +2,7 @@
 // here, so the hypoelastic law is written once.
 #pragma once
 #include "MaterialParams.hpp"
-#include "Particles.hpp"
+#include "../core/Particles.hpp"
 
 namespace mpm {
 

@@ -3,7 +3,7 @@
 // velocity of a YADE body), contact groups (μ, c, χ, d0 of Eqs. 23–24) and their surface primitives (box,
 // plane, sphere, segment/triangle elements), and the per-particle d0 of d0 = "initial". Set up between
 // steps; the per-step algorithm that uses them is PtsContact (PtsContact.hpp).
-#include "Particles.hpp"
+#include "../core/Particles.hpp"
 #include "RigidSurface.hpp"
 
 #include <algorithm>

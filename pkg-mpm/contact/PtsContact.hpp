@@ -59,12 +59,12 @@
 // rank's copy, and the sums over nodes (the reactions, A and b of bodyResponse) count each node on its owner
 // rank only and are added over the ranks in rank order: every rank gets the same reaction bits.
 #pragma once
-#include "BlockSchedule.hpp"
+#include "../core/BlockSchedule.hpp"
 #include "ContactGroups.hpp"
-#include "ContactMpi.hpp"
-#include "GridBoxes.hpp"
+#include "../mpi/ContactMpi.hpp"
+#include "../core/GridBoxes.hpp"
 #include "KinematicContact.hpp"
-#include "WlsShape.hpp"
+#include "../core/WlsShape.hpp"
 
 namespace mpm {
 

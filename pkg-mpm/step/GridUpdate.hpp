@@ -1,7 +1,7 @@
 // The grid update of a step (paper Fig. 2, Eq. 18; the MUSL remap is in MuslStep.hpp), called by every
 // thread of the solver's parallel region.
 #pragma once
-#include "Grid.hpp"
+#include "../core/Grid.hpp"
 
 namespace mpm {
 

@@ -20,7 +20,7 @@
 // λ_n clamped ≥ 0 and λ_t to the Coulomb + cohesion disc; a free body's velocity is updated with each impulse
 // (−W_B J_pᵀ Δλ), so it takes its share of every exchange.
 #pragma once
-#include "MpmTypes.hpp"
+#include "../core/MpmTypes.hpp"
 
 namespace mpm {
 

@@ -22,7 +22,7 @@
 // after each nodal update (MirrorPlanes.hpp). h_p(x) = v_p + C_p (x − x_p): the particle's linear
 // velocity field (x̄_p for a cut stencil, WlsShape.hpp).
 #pragma once
-#include "ContactPhase.hpp"
+#include "../contact/ContactPhase.hpp"
 #include "GridUpdate.hpp"
 #include "ParticleUpdate.hpp"
 #include <omp.h>

@@ -22,7 +22,7 @@
 // Without bodies the step does no contact work at all (active() is false: no call, no allocation).
 #pragma once
 #include "PtsContact.hpp"
-#include "Transfer.hpp"
+#include "../step/Transfer.hpp"
 
 namespace mpm {
 

@@ -2,7 +2,7 @@
 // Boost.Python layer YADE uses. Each file exposes one concern; the Solver2D/3D class is created in
 // bind_solver.cpp and the others add their methods to it.
 #pragma once
-#include "../pkg-mpm/Solver.hpp"
+#include "../step/Solver.hpp"
 #include "param_binding.hpp"
 #include <boost/python.hpp>
 #include <boost/python/numpy.hpp>

@@ -9,7 +9,7 @@
 // share the 2·margin + 3 = 5 layers around their common boundary; B > 2·margin + 2 keeps the shared bands
 // of one rank apart, so a node is shared by two ranks at most (its sum a + b is the same bits on both).
 #pragma once
-#include "BlockSchedule.hpp"
+#include "../core/BlockSchedule.hpp"
 #include <algorithm>
 #include <string>
 #include <vector>

@@ -3,11 +3,11 @@
 // with the paper's equations, reads in one place, MuslStep.hpp (P2G → grid update → contact → G2P →
 // MUSL remap → stress update → positions).
 #pragma once
-#include "Decomposition.hpp"
-#include "MaterialSet.hpp"
+#include "../mpi/Decomposition.hpp"
+#include "../material/MaterialSet.hpp"
 #include "MuslStep.hpp"
 #include "Removal.hpp"
-#include "SolverSettings.hpp"
+#include "../core/SolverSettings.hpp"
 #include <omp.h>
 
 namespace mpm {

@@ -6,9 +6,9 @@
 // for any thread count. p2g and g2p are called by every thread of the solver's parallel region
 // (orphaned worksharing loops); failures are recorded in an ErrorRecord, never thrown inside the region.
 #pragma once
-#include "BlockSchedule.hpp"
+#include "../core/BlockSchedule.hpp"
 #include "Kinematics.hpp"
-#include "Lanes.hpp"
+#include "../core/Lanes.hpp"
 #include <atomic>
 #include <omp.h>
 

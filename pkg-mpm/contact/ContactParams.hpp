@@ -3,7 +3,7 @@
 // and range, keyword constructor, toDict/fromDict for checkpoints), the registration keywords of
 // ym.RigidBodies/ym.DemSpheres and the tables of doc/contact.md all come from this list.
 #pragma once
-#include "ParamTable.hpp"
+#include "../core/ParamTable.hpp"
 
 namespace mpm {
 // How the contact keeps particles out of a rigid body (doc/contact.md, "Contact laws").

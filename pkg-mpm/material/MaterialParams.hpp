@@ -4,7 +4,7 @@
 // (FrictMat/JCFpmMat: young, poisson, density, frictionAngle, cohesion; JCFpmMat's
 // jointDilationAngle → dilationAngle, with the paper's "dilatancyAngle" kept as a Python alias).
 #pragma once
-#include "ParamTable.hpp"
+#include "../core/ParamTable.hpp"
 
 namespace mpm {
 // Named options of DpGkMat (Python sees the words; enumerator k = word k).

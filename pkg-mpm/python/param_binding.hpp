@@ -9,7 +9,7 @@
 //   - the static paramTable(): list of dicts (name, type, default, unit, lo, hi, ends, symbol, doc, eq, gate).
 // The class must be held by std::shared_ptr<S> and have a validate() method (whole-object checks).
 #pragma once
-#include "../pkg-mpm/ParamTable.hpp"
+#include "../core/ParamTable.hpp"
 #include <boost/mpl/vector.hpp>
 #include <boost/python.hpp>
 #include <boost/python/raw_function.hpp>

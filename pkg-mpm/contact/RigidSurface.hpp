@@ -14,7 +14,7 @@
 // the closest surface point and the part owning that point; `velocityAt(part, x)` = v + ω × (x − c).
 #pragma once
 #include "ContactParams.hpp"
-#include "MpmTypes.hpp"
+#include "../core/MpmTypes.hpp"
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <limits>

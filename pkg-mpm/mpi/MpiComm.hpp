@@ -6,7 +6,7 @@
 // MPI_THREAD_FUNNELED). Reductions whose result enters the state are max/min (exact) or sums of integers
 // stored as doubles (exact), so every rank gets the same bits.
 #pragma once
-#include "MpmTypes.hpp"
+#include "../core/MpmTypes.hpp"
 #include <algorithm>
 #include <vector>
 

@@ -2,7 +2,7 @@
 // velocity gradient, then the position update with the stability and re-sort checks (run per block
 // right after the block's stress update).
 #pragma once
-#include "MaterialSet.hpp"
+#include "../material/MaterialSet.hpp"
 #include "Transfer.hpp"
 
 namespace mpm {

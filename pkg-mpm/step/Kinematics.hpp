@@ -2,7 +2,7 @@
 // strain increment (Eq. 29), objective (Jaumann) stress rotation and volume ratio det(I + Δt L),
 // plus the small tensor helpers the transfers share.
 #pragma once
-#include "SymTensor.hpp"
+#include "../core/SymTensor.hpp"
 #include <Eigen/LU>
 
 namespace mpm {
