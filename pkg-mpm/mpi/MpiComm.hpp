@@ -1,7 +1,4 @@
 // The MPI layer of the distributed build (module yade_mpm._core_mpi, compiled with -DMPM_MPI; doc/scaling.md).
-// The serial module yade_mpm._core is compiled from the same sources without MPM_MPI: every hook in the
-// step is written as MPM_IF_MPI(…), which expands to nothing there, so its loops and data are unchanged.
-//
 // Comm wraps the few MPI calls the decomposition needs (MPI_COMM_WORLD, called by one thread of a rank:
 // MPI_THREAD_FUNNELED). Reductions whose result enters the state are max/min (exact) or sums of integers
 // stored as doubles (exact), so every rank gets the same bits.
@@ -12,15 +9,6 @@
 
 #ifdef MPM_MPI
 #include <mpi.h>
-#define MPM_IF_MPI(...) __VA_ARGS__
-// A block run by one thread of a parallel region that may call MPI: the master thread (FUNNELED) and a
-// barrier after it (MPM_ONE_THREAD_END); the serial build keeps `omp single` (its implicit barrier).
-#define MPM_ONE_THREAD _Pragma("omp master")
-#define MPM_ONE_THREAD_END _Pragma("omp barrier")
-#else
-#define MPM_IF_MPI(...)
-#define MPM_ONE_THREAD _Pragma("omp single")
-#define MPM_ONE_THREAD_END
 #endif
 
 namespace mpm {

@@ -22,7 +22,7 @@
 // after each nodal update (MirrorPlanes.hpp). h_p(x) = v_p + C_p (x − x_p): the particle's linear
 // velocity field (x̄_p for a cut stencil, WlsShape.hpp).
 #pragma once
-#include "../contact/ContactPhase.hpp"
+#include "../contact/PtsContact.hpp"
 #include "GridUpdate.hpp"
 #include "ParticleUpdate.hpp"
 #include <omp.h>
@@ -64,21 +64,18 @@ inline void stampTime(double& t)
 // cores): every thread calls each phase, whose worksharing loops end with a barrier, and every thread
 // takes the same branches. A phase that recorded a failure (errP2G, errContact, errG2P) ends the region;
 // the caller throws. t[1..4]: wall clock after P2G, grid update, contact, G2P + MUSL remap.
-// sumShared(field, err, phase): MPI build, adds the neighbour ranks' partial sums of the shared nodes
-// (HaloExchange.hpp); the serial build passes NoExchange, which is empty.
-struct NoExchange {
-	template <class F>
-	void operator()(F&, ErrorRecord&, const char*) const { }
-};
-template <int D, class Mat, class Exchange = NoExchange>
-inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<D>& cs, const Mat& mat, const StepInputs<D>& in,
-                       ErrorRecord& errP2G, ErrorRecord& errContact, ErrorRecord& errG2P, double (&t)[6], Exchange&& sumShared = Exchange {})
+// cs.exchange (core/Exchange.hpp) adds the other processes' partial sums of the shared nodes after each scatter.
+template <int D, class Contact, class Mat, class X>
+inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D, X>& cs, const Mat& mat, const StepInputs<D>& in,
+                       ErrorRecord& errP2G, ErrorRecord& errG2P, double (&t)[6])
 {
+	const X&     ex         = cs.exchange;
+	ErrorRecord& errContact = cs.err;
 	Grid<D>& grid = xfer.grid;
 #pragma omp parallel
 	{
 		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, in.dt, in.damping == 0, errP2G); // 1: Eqs. 20–22 (no damping: p + Δt f fused)
-		sumShared(grid.nodes, errP2G, "P2G");                            // MPI: + neighbours' partial sums
+		ex.sumShared(grid, grid.nodes, errP2G, "P2G");                   // + the other processes' partial sums
 		if (in.mirrors) grid.foldMirrors(grid.nodes);                    // symmetry planes: add the reflected images
 		stampTime(t[1]);
 		if (errP2G.none()) {
@@ -97,7 +94,7 @@ inline void gridPhases(Transfer<D>& xfer, ContactPhase<D>& contact, ContactStep<
 			stampTime(t[3]);
 			if (errContact.none()) {
 				xfer.g2p(errG2P); // 4: Eqs. 6–7, MUSL momentum (Eq. 16)
-				sumShared(grid.mom, errG2P, "G2P"); // MPI: + neighbours' partial sums
+				ex.sumShared(grid, grid.mom, errG2P, "G2P"); // + the other processes' partial sums
 				if (errG2P.none()) {
 					if (in.mirrors) grid.foldMirrors(grid.mom);
 					gridMusl(grid, in.massFloor); // 5: Eq. 17

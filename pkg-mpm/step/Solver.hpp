@@ -3,12 +3,30 @@
 // with the paper's equations, reads in one place, MuslStep.hpp (P2G → grid update → contact → G2P →
 // MUSL remap → stress update → positions).
 #pragma once
-#include "../mpi/Decomposition.hpp"
+#include "../core/Exchange.hpp"
+#include "../core/SolverSettings.hpp"
 #include "../material/MaterialSet.hpp"
 #include "MuslStep.hpp"
 #include "Removal.hpp"
-#include "../core/SolverSettings.hpp"
 #include <omp.h>
+
+// The MPI build (module yade_mpm._core_mpi, -DMPM_MPI; doc/scaling.md) runs the step with the exchange policy of
+// the solver's decomposition (mpi/); MPM_IF_MPI(…) marks its few other lines and expands to nothing in the serial
+// module, which is compiled without any MPI code.
+#ifdef MPM_MPI
+#include "../mpi/MpiExchange.hpp"
+#define MPM_IF_MPI(...) __VA_ARGS__
+namespace mpm {
+template <int D>
+using StepExchange = MpiExchange<D>;
+}
+#else
+#define MPM_IF_MPI(...)
+namespace mpm {
+template <int D>
+using StepExchange = LocalExchange;
+}
+#endif
 
 namespace mpm {
 
@@ -30,7 +48,7 @@ public:
 	// ---- state ----
 	Grid<D>         grid;
 	Particles<D>    P;
-	ContactPhase<D> contact;
+	PtsContact<D>   contact;
 	Real            lastDt = 0; // Δt of the last step [s]
 	PhaseTimes      phase;
 	MPM_IF_MPI(Decomposition<D> dd;) // MPI build only: slabs, migration, shared-node sums (Decomposition.hpp)
@@ -44,7 +62,7 @@ public:
 	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched)
 	{
 		materials.setCell(grid.spacing);
-		MPM_IF_MPI(contact.dd = &dd;) // MPI: the contact sums its shared nodes and reduces the body reactions
+		MPM_IF_MPI(exchange.dd = &dd;) // MPI: the step's shared-node sums and the contact's reductions over the ranks
 	}
 	Solver(const Solver&)            = delete; // xfer refers to the members
 	Solver& operator=(const Solver&) = delete;
@@ -151,13 +169,13 @@ public:
 			sched.sort(grid, P), needSort = false;
 		}
 		errP2G.clear(), errContact.clear(), errG2P.clear();
-		ContactStep<D>      cs { xfer, dt, time, massFloor, errContact };
+		const ContactStep<D, StepExchange<D>> cs { grid, P, sched, xfer.offs, dt, massFloor, errContact, exchange };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
 			                     liveViews > 0 || viewTaken }; // viewWrites: P2G checks what views may have changed
 		if (in.withContact) contact.beforeTransfer(cs);
 		double t[6] = { omp_get_wtime() };
 		materials.dispatch([&](const auto& mat) {
-			gridPhases(xfer, contact, cs, mat, in, errP2G, errContact, errG2P, t MPM_IF_MPI(, [&](auto& f, ErrorRecord& e, const char* ph) { if (dd.distributed()) dd.halo.sum(dd.layout, grid, dd.rank, f, e, ph); }));       // MuslStep.hpp: phases 1–5
+			gridPhases(xfer, contact, cs, mat, in, errP2G, errG2P, t); // MuslStep.hpp: phases 1–5
 			throwIf(errP2G, "P2G", false), throwIf(errContact, "contact", false); // particles untouched so far
 			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
@@ -247,6 +265,7 @@ private:
 	MaterialSet<D>   materials;
 	BlockSchedule<D> sched;
 	Transfer<D>      xfer;               // the transfers, bound to grid, P and sched
+	StepExchange<D>  exchange;           // sums and decisions shared with the other processes (core/Exchange.hpp)
 	bool             needSort  = true;   // particles must be re-sorted by block before the next transfer
 	bool             needCheck = true;   // particle data changed from outside: validate and refresh ρ_min, mass floor
 	bool             viewTaken = true;   // a view was handed out since the last accepted P2G
