@@ -138,8 +138,6 @@ struct RigidGroup {
 	bool                     d0Captured   = false;
 	bool                     topologyKnown = false;
 
-	size_t nElements() const { return elemPart.size(); }
-
 	struct Hit {
 		Real d = INFINITY; // signed distance, > 0 outside [m]
 		Vec  n;            // outward unit normal at the closest point

@@ -58,7 +58,6 @@ struct Grid {
 	std::vector<uint8_t> fixMask;     // bit a set: velocity component a is prescribed zero
 	std::vector<uint8_t> excluded;    // exclusion bits (ExclusionBit); any bit → left out of the WLS fits
 	std::vector<uint8_t> stencilExcl; // number of excluded nodes in the 4^D stencil starting at this node
-	enum : uint8_t { ExclUser = 4, ExclContact = 8 }; // names used by the contact phase (= ExGap, ExContact)
 	std::vector<BoundaryPlane<D>> planes;
 	Vec allowedLo, allowedHi; // particles must stay in [allowedLo, allowedHi): the physical grid cut by the planes
 
@@ -211,14 +210,6 @@ struct Grid {
 		if (partnerOf(i) != i) return;
 		forImages(i, [&](size_t j) { writeBits(j, bits, on); });
 	}
-	// Clears a bit on every node (e.g. the contact phase before marking the nodes of this step).
-	void clearBitEverywhere(uint8_t bit)
-	{
-		bool changed = false;
-		for (size_t i = 0; i < size(); ++i)
-			if (excluded[i] & bit) excluded[i] &= uint8_t(~bit), changed = true;
-		if (changed) recountStencils();
-	}
 	// The user/gap exclusion of one physical node (Python: setNodeExcluded).
 	void setExcluded(size_t i, bool ex)
 	{
@@ -226,20 +217,8 @@ struct Grid {
 		if (isGhost(i)) throw InputError("node index " + std::to_string(i) + " is a ghost node outside the physical grid");
 		setBits(i, ExGap, ex);
 	}
-	// Contact's own bit (a node covered by a rigid body, Fig. 1b), set and cleared every step by the contact
-	// phase without touching the other bits. No range check: the contact phase passes physical nodes only.
-	void setContactExcluded(size_t i, bool ex) { setBits(i, ExContact, ex); }
-	bool isExcluded(size_t i) const { return excluded[i] != 0; }
-	// Any excluded node in the stencil whose first node is `base` (one load; the kernels' branch).
-	bool stencilHasExcluded(size_t base) const { return stencilExcl[base] != 0; }
 
 	// ------------------------------------------------------------------ symmetry planes (MirrorPlanes.hpp)
-	template <class E>
-	void foldMirrors(std::vector<E>& field) { mirrors.fold(field); }
-	template <class E>
-	void unfoldMirrors(std::vector<E>& field) { mirrors.unfold(field); }
-	template <class F>
-	void forEachMirrorPair(F&& f) const { mirrors.forEachPair(f); }
 	Real mirrorShare(size_t i) const { return mirrors.share(coords(i)); } // weight of node i in body reactions
 	// The node whose content node i mirrors after unfold (partnerOf), with the reflection per axis: v_i = sign ∘ v_j
 	// (sign[a] = −1 where the partner lies across a plane normal to a).

@@ -96,7 +96,8 @@ public:
 	void forEachPair(F&& f) const
 	{
 		for (const auto& m : list)
-			for (size_t col : m.columns) forPairs(m, [&](int k, int kp) { f(col + size_t(k) * m.stride, col + size_t(kp) * m.stride, m.axis); });
+			for (size_t col : m.columns)
+				for (int j = 0; j < m.nPairs; ++j) f(col + size_t(m.pairK[j]) * m.stride, col + size_t(m.pairKp[j]) * m.stride, m.axis);
 	}
 	// The nodes of the modelled region that receive a particle's contribution to the node at c0 in the mirror-symmetric
 	// full-space problem (what fold does to the nodal sums): f(c, sign) for c0 itself if it is not beyond a plane, and
@@ -203,14 +204,6 @@ private:
 		for (int i = 0; i < NodeVec<D>::S; ++i) l[i] = 1;
 		l[axis] = -1;
 		return l;
-	}
-
-	// Visits (material-side node line k, partner kp) for the node lines within 2 cells of mirror m,
-	// including the line on the plane (k == kp).
-	template <class F>
-	static void forPairs(const Mirror& m, F&& f)
-	{
-		for (int j = 0; j < m.nPairs; ++j) f(m.pairK[j], m.pairKp[j]);
 	}
 };
 

@@ -39,7 +39,6 @@ struct StencilOffsets {
 			off[n] = k;
 		}
 	}
-	StencilOffsets() = default;
 };
 
 // Per-particle, per-step tensor-product data: the 4 one-dimensional B-spline weights and node offsets
@@ -98,12 +97,7 @@ inline void computeKernel(const KernelGeom<D>& g, const Real* x, Kernel<D>& k)
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
 	k.base    = base;
-	k.general = g.stencilExcl[base] != 0; // one load (Grid::stencilHasExcluded): ghosts near the grid edge, planes, gaps, contact
-}
-template <int D, bool checked = true>
-inline void computeKernel(const Grid<D>& g, const StencilOffsets<D>&, const Real* x, Kernel<D>& k)
-{
-	computeKernel<D, checked>(KernelGeom<D>(g), x, k);
+	k.general = g.stencilExcl[base] != 0; // one load: ghosts near the grid edge, planes, gaps, contact
 }
 
 // Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit
@@ -202,7 +196,7 @@ template <int D>
 inline bool computeStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Real* x, Stencil<D>& st)
 {
 	Kernel<D> k;
-	computeKernel(g, so, x, k);
+	computeKernel(KernelGeom<D>(g), x, k);
 	return k.inside && fillStencil(g, so, k, st);
 }
 

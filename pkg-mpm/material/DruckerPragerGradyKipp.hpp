@@ -192,9 +192,6 @@ struct DruckerPragerGradyKipp {
 		return r;
 	}
 
-	// Threshold of a particle's first flaw: Eq. 37 (deterministic) or the first of its Weibull flaws.
-	Real initialThreshold(Real vol0, int64_t id) const { return mpm::initialThreshold(mat, vol0, cell, D, id); }
-
 	// ε̄ of Eq. 36 from the undamaged state stress (smax = its maximum principal value).
 	Real damageStrain(const Sym<D>& s, Real smax) const
 	{

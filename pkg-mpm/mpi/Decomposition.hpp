@@ -149,20 +149,20 @@ public:
 	}
 
 	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.
-	void reduceLimits(Real& rhoMin, Real& vmax, Real& massFloor) const
+	void reduceLimits(Real& dtDensityMin, Real& vmax, Real& massFloor) const
 	{
 		if (!distributed()) return;
-		double v[3] = { -rhoMin, vmax, -massFloor };
+		double v[3] = { -dtDensityMin, vmax, -massFloor };
 		Comm::max(v, 3);
-		rhoMin = -v[0], vmax = v[1], massFloor = -v[2];
+		dtDensityMin = -v[0], vmax = v[1], massFloor = -v[2];
 	}
 	// End of step: global ρ_min, max ‖v‖², re-sort flag, particles that left the grid; a failure of the particle pass on any rank stops all.
-	void reduceStep(Real& rhoMin, Real& v2max, int& drift, ErrorRecord& errStress, ErrorRecord& errMove) const
+	void reduceStep(Real& dtDensityMin, Real& v2max, int& drift, ErrorRecord& errStress, ErrorRecord& errMove) const
 	{
 		if (!distributed()) return;
-		double v[5] = { -rhoMin, v2max, double(drift), errStress.none() && errMove.none() ? 0.0 : 1.0, errMove.left.empty() ? 0.0 : 1.0 };
+		double v[5] = { -dtDensityMin, v2max, double(drift), errStress.none() && errMove.none() ? 0.0 : 1.0, errMove.left.empty() ? 0.0 : 1.0 };
 		Comm::max(v, 5);
-		rhoMin = -v[0], v2max = v[1], drift = int(v[2]);
+		dtDensityMin = -v[0], v2max = v[1], drift = int(v[2]);
 		errMove.leftAnywhere = v[4] > 0; // a particle left the grid on some rank: every rank settles it (Solver::settleLeaving)
 		if (v[3] > 0 && errStress.none() && errMove.none())
 			errMove.record(ErrorRecord::elsewhere, "stopped: the stress or position update of another MPI rank failed (its message names the particle)");

@@ -29,7 +29,6 @@ struct Comm {
 		return s;
 	}
 	static void max(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, world()); }
-	static void min(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MIN, world()); }
 	static void sum(double* v, int n) { MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, world()); }
 	static void maxBytes(uint8_t* v, size_t n) // element-wise max of a byte map (cell occupancy), in chunks of < 2^31
 	{

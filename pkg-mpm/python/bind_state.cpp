@@ -60,7 +60,7 @@ struct StateWrap {
 		const auto r = s.resumeState();
 		bp::dict   d;
 		d["steps"] = r.steps, d["time"] = r.time, d["lastDt"] = r.lastDt, d["externalWork"] = r.externalWork;
-		d["vmax"] = r.vmax, d["rhoMin"] = r.rhoMin, d["massFloor"] = r.massFloor;
+		d["vmax"] = r.vmax, d["rhoMin"] = r.dtDensityMin, d["massFloor"] = r.massFloor;
 		d["needSort"] = r.needSort, d["needCheck"] = r.needCheck;
 		const auto& st = s.schedule().start;
 		np::ndarray a  = np::empty(bp::make_tuple(st.size()), np::dtype::get_builtin<uint32_t>());
@@ -79,7 +79,7 @@ struct StateWrap {
 		r.lastDt       = bp::extract<double>(d["lastDt"]);
 		r.externalWork = bp::extract<double>(d["externalWork"]);
 		r.vmax         = bp::extract<double>(d["vmax"]);
-		r.rhoMin       = bp::extract<double>(d["rhoMin"]);
+		r.dtDensityMin = bp::extract<double>(d["rhoMin"]); // the checkpoint key keeps its name
 		r.massFloor    = bp::extract<double>(d["massFloor"]);
 		r.needSort     = bp::extract<bool>(d["needSort"]);
 		r.needCheck    = bp::extract<bool>(d["needCheck"]);

@@ -76,7 +76,7 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 	{
 		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, in.dt, in.damping == 0, errP2G); // 1: Eqs. 20–22 (no damping: p + Δt f fused)
 		ex.sumShared(grid, grid.nodes, errP2G, "P2G");                   // + the other processes' partial sums
-		if (in.mirrors) grid.foldMirrors(grid.nodes);                    // symmetry planes: add the reflected images
+		if (in.mirrors) grid.mirrors.fold(grid.nodes);                   // symmetry planes: add the reflected images
 		stampTime(t[1]);
 		if (errP2G.none()) {
 			const bool dampLate = in.withContact && in.damping > 0; // damp the net force, contact included
@@ -90,15 +90,15 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 					contact.reproject(cs); // kinematic law: the damped velocities meet the constraints again
 				}
 			}
-			if (in.mirrors) grid.unfoldMirrors(grid.nodes), grid.unfoldMirrors(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
+			if (in.mirrors) grid.mirrors.unfold(grid.nodes), grid.mirrors.unfold(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
 			stampTime(t[3]);
 			if (errContact.none()) {
 				xfer.g2p(errG2P); // 4: Eqs. 6–7, MUSL momentum (Eq. 16)
 				ex.sumShared(grid, grid.mom, errG2P, "G2P"); // + the other processes' partial sums
 				if (errG2P.none()) {
-					if (in.mirrors) grid.foldMirrors(grid.mom);
+					if (in.mirrors) grid.mirrors.fold(grid.mom);
 					gridMusl(grid, in.massFloor); // 5: Eq. 17
-					if (in.mirrors) grid.unfoldMirrors(grid.vmusl);
+					if (in.mirrors) grid.mirrors.unfold(grid.vmusl);
 				}
 			}
 		}

@@ -15,7 +15,7 @@ namespace mpm {
 // The particle loop is kept as it is: the compiler's FMA contraction depends on its context, and moving
 // it (e.g. into a per-block function) changed plastic stresses in the last bit.
 struct ParticleStepStats {
-	Real rhoMin = INFINITY, v2max = 0;
+	Real dtDensityMin = INFINITY, v2max = 0; // min dtDensity (MaterialSet.hpp: ρ, or ρ/M in a mixed scene), max ‖v‖²
 	int  drift  = 0;
 };
 template <int D, class Mat, class After>

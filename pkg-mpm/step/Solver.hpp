@@ -140,7 +140,7 @@ public:
 
 	// ---------------------------------------------------------------- time step
 	// Characteristic P-wave speed v_c = max over materials of √((K + 4G/3)/ρ_min) [m/s].
-	Real waveSpeed() { return prepare(), materials.waveSpeed(rhoMin); }
+	Real waveSpeed() { return prepare(), materials.waveSpeed(dtDensityMin); }
 	// Paper's stability condition Δt = C·l/(v_c + max‖v‖) with the current particle velocities.
 	Real stableDt() { return prepare(), courant * grid.spacing / (waveSpeed() + vmax); }
 	// One step with the automatic Δt (autoDt) or fixedDt.
@@ -181,10 +181,10 @@ public:
 			throwIf(errG2P, "G2P", true);
 			ErrorRecord errStress, errMove;
 			auto        st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
-			MPM_IF_MPI(dd.reduceStep(st.rhoMin, st.v2max, st.drift, errStress, errMove);) // global Δt limits, re-sort flag
+			MPM_IF_MPI(dd.reduceStep(st.dtDensityMin, st.v2max, st.drift, errStress, errMove);) // global Δt limits, re-sort flag
 			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
 			if (errMove.leftAnywhere) settleLeaving(errMove, dt); // a particle left the grid (on some rank): outside policy
-			vmax = std::sqrt(st.v2max), rhoMin = st.rhoMin;
+			vmax = std::sqrt(st.v2max), dtDensityMin = st.dtDensityMin;
 			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
 			t[5] = omp_get_wtime();
 		});
@@ -241,10 +241,10 @@ public:
 	// block schedule, these are everything the next step reads, so a resumed run is bitwise identical.
 	struct ResumeState {
 		long steps;
-		Real time, lastDt, externalWork, vmax, rhoMin, massFloor;
+		Real time, lastDt, externalWork, vmax, dtDensityMin, massFloor;
 		bool needSort, needCheck;
 	};
-	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, rhoMin, massFloor, needSort, needCheck }; }
+	ResumeState resumeState() const { return { steps, time, lastDt, externalWork, vmax, dtDensityMin, massFloor, needSort, needCheck }; }
 	void setResumeState(const ResumeState& r, const std::vector<uint32_t>& blockStart)
 	{
 		const long s0 = steps;
@@ -256,7 +256,7 @@ public:
 			throw InputError("checkpoint: the block schedule does not fit this grid and particle count");
 		}
 		lastDt = r.lastDt;
-		vmax = r.vmax, rhoMin = r.rhoMin, massFloor = r.massFloor;
+		vmax = r.vmax, dtDensityMin = r.dtDensityMin, massFloor = r.massFloor;
 		needSort = r.needSort, needCheck = r.needCheck;
 		failure.clear();
 	}
@@ -269,7 +269,8 @@ private:
 	bool             needSort  = true;   // particles must be re-sorted by block before the next transfer
 	bool             needCheck = true;   // particle data changed from outside: validate and refresh ρ_min, mass floor
 	bool             viewTaken = true;   // a view was handed out since the last accepted P2G
-	Real             vmax = 0, rhoMin = INFINITY, massFloor = 0;
+	Real             vmax = 0, massFloor = 0;
+	Real             dtDensityMin = INFINITY; // min dtDensity of the particles: ρ (one material) or ρ/M (mixed; MaterialSet.hpp)
 	ErrorRecord      errP2G, errContact, errG2P; // shared by the threads of the transfer region
 	std::string      failure;                    // message of a step that failed with particles partly updated
 	std::vector<RemovedParticle<D>> removed;     // particles taken out after leaving the grid (outside policy)
@@ -352,7 +353,7 @@ private:
 	{
 		if (P.n == 0 MPM_IF_MPI(&&!dd.decomposed)) throw InputError("particles: no particles in the solver; add particles before stepping");
 		if (materials.size() == 0) throw InputError("material: no material assigned; set a material before stepping");
-		if (!std::isfinite(rhoMin) || needCheck) {
+		if (!std::isfinite(dtDensityMin) || needCheck) {
 			// State edited through the live views (requestSort() after editing) is validated like
 			// addParticles input: a NaN or off-grid position would index outside the node arrays.
 			auto validate = [&] {
@@ -361,12 +362,12 @@ private:
 					const auto& e = materials.of(P, p);
 					return e.kind == MaterialKind::DruckerPragerGradyKipp && e.dpgk.damage;
 				});
-				rhoMin    = materials.single() ? c.rhoMin : materials.minDtDensity(P);
+				dtDensityMin = materials.single() ? c.rhoMin : materials.minDtDensity(P);
 				vmax      = c.vmax; // also lowered when velocities were lowered through the views
 				massFloor = 1e-14 * c.massMin; // nodes lighter than this carry no velocity (only roundoff-level mass)
 			};
 #ifdef MPM_MPI
-			dd.agree(validate), dd.reduceLimits(rhoMin, vmax, massFloor); // every rank stops if one fails; global limits
+			dd.agree(validate), dd.reduceLimits(dtDensityMin, vmax, massFloor); // every rank stops if one fails; global limits
 #else
 			validate();
 #endif

@@ -25,19 +25,9 @@ public:
 
 	Transfer(Grid<D>& g, Particles<D>& p, const BlockSchedule<D>& s) : grid(g), P(p), sched(s), offs(g) { }
 
-	// Particles of block b, in storage order.
-	template <class F>
-	void forBlock(uint32_t b, F&& f) const
-	{
-		for (uint32_t p = sched.start[b]; p < sched.start[b + 1]; ++p) f(size_t(p));
-	}
-	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums);
-	// fb(b) handles block b. scatterPass(f) calls f(p) for every particle of every block.
-	// Thread t first takes its own share of each colour (BlockSchedule::colourShare: contiguous, equal particle
-	// counts), the same part of the grid in every pass of a step, so the nodes it sums stay in its core's caches
-	// (dynamic scheduling hands blocks out in turn and moves every node line between the cores); then it helps
-	// with what is left of the other shares (a preempted or slower thread does not hold the colour up). Blocks
-	// are claimed through per-share counters; which thread sums a block changes no result.
+	// Scatter pass: colours in sequence, blocks of one colour in parallel (deterministic sums); fb(b) handles
+	// block b. Thread t takes its own share of each colour first (BlockSchedule::colourShare), then helps with the
+	// others' (blocks claimed through per-share counters; which thread sums a block changes no result).
 	template <class FB>
 	void scatterBlocks(FB&& fb) const
 	{
@@ -64,18 +54,13 @@ public:
 			claimed[c][t].n.store(0, std::memory_order_relaxed); // unused until this pass's next call: barriers lie between
 		}
 	}
-	template <class F>
-	void scatterPass(F&& f) const
-	{
-		scatterBlocks([&](uint32_t b) { forBlock(b, f); });
-	}
 	// checked = false: inside the grid for sure (G2P and the stress pass, after P2G accepted the positions).
 	template <bool checked = true>
 	void kernelOf(size_t p, Kernel<D>& k) const
 	{
 		Real x[D];
 		for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
-		computeKernel<D, checked>(grid, offs, x, k);
+		computeKernel<D, checked>(KernelGeom<D>(grid), x, k);
 	}
 
 	// ------------------------------------------------------------ P2G: Eqs. 20–22
