@@ -1,8 +1,7 @@
 #pragma once
-// Registration of the rigid bodies a scene's MPM particles touch (paper Sec. 2.3): rigid parts (pose and
-// velocity of a YADE body), contact groups (μ, c, χ, d0 of Eqs. 23–24) and their surface primitives (box,
-// plane, sphere, segment/triangle elements), and the per-particle d0 of d0 = "initial". Set up between
-// steps; the per-step algorithm that uses them is PtsContact (PtsContact.hpp).
+// Registration of the rigid bodies a scene's MPM particles touch (paper Sec. 2.3): rigid parts (pose and velocity
+// of a YADE body), contact groups (μ, c, χ, d0 of Eqs. 23–24) with their surface primitives, and the per-particle
+// d0 of d0 = "initial". Set up between steps; the step's contact phase is PtsContact.hpp.
 #include "../core/Particles.hpp"
 #include "RigidSurface.hpp"
 
@@ -110,13 +109,9 @@ public:
 	}
 
 	// d0 = "initial" (ContactParams::initialD0): d0_p := d_p(0) for the first lattice layer of particles next to
-	// the group's surface at its current pose (the registration; bodies.py calls it right after adding the
-	// primitives and reading the poses), stored per stable particle id (sorting needs no plumbing; particles
-	// added later keep the default). First layer: d_p(0) < e_p max_i |n_i| with e_p = V_p^{1/D} and n the
-	// outward normal at the closest point — along a straight face exactly one particle of every lattice line
-	// along the dominant normal axis (those lines cross the face at a slope, consecutive particles of a line
-	// are e_p |n_i| apart in distance). It contains every particle within the default d0 = ½ e_p, since
-	// max_i |n_i| ≥ 1/√D > ½. A particle centre inside the body (d_p(0) < 0) is refused.
+	// the group's surface at its current pose (at registration), stored per stable particle id. First layer:
+	// d_p(0) < e_p max_i |n_i|, e_p = V_p^{1/D}, n the outward normal at the closest point. A particle centre inside
+	// the body (d_p(0) < 0) is refused.
 	void captureInitialD0(int gi, const Particles<D>& P)
 	{
 		auto& g = group(gi);

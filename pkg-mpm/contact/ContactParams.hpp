@@ -15,15 +15,8 @@ enum class ContactLaw : int {
 MPM_CHOICES(ContactLaw, "kinematic|penalty")
 } // namespace mpm
 
-// X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate)
-// chi default ½: positions advance with the updated velocity (x += Δt v^{n+1}), so (1 − χ) κ = m/Δt² takes a
-// penetrating particle back to d0 in exactly one step; χ = 0 pushes it out by twice its penetration (the
-// contact layer is reflected; measured +15 % total energy at the first contact of a 3D block dropped on a wall).
-// autoD0: ½ V_p^{1/D} is half the particle's edge, i.e. contact when the particle's face touches.
-// initialD0: the paper's d0 is "the initial distance of particle used for the contact detection" (text after
-// Eq. 26); the first lattice layer next to the surface at registration gets d0_p = d_p(0) (a body filling a
-// domain, e.g. a flaw filler, touches the material around it at zero force from t = 0), every other particle
-// keeps the autoD0/d0 value. First layer: d_p(0) < e_p max_i |n_i| (ContactGroups::captureInitialD0).
+// X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate). Why chi = ½, autoD0 and initialD0:
+// doc/developer/core_notes.md.
 #define MPM_CONTACT_PARAMS(X)                                                                                                     \
 	X(ContactLaw, law, ContactLaw::Kinematic, "-", 0, 1, CC, "",                                                               \
 	  "'kinematic' (default): no-penetration impulses at the contacting particles (projected Gauss–Seidel), the Δt → 0 "    \

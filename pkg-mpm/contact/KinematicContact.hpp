@@ -1,14 +1,7 @@
-// The kinematic contact law (ContactLaw::Kinematic, the default; doc/contact.md "Contact laws"): the Δt → 0 limit
-// of Eq. 23, a non-penetrating frictional contact at the particles' faces, reached at any Δt by constraining
-// velocities. A particle with d_p − d0 < ε_p touches; its material-point velocity v_p = Σ_i ψ_i v_i (Eq. 6)
-// relative to the body at x_p, u_p = v_p − (v + ω × r_p) (Eq. 26), is constrained after the grid update:
-//   normal      u_p·n_p ≥ g_p,  g_p = (d0 − d_p)/Δt
-//   tangential  u_p,tan = 0 while ‖λ_t‖ ≤ μ λ_n + c a_p Δt   (Eq. 24 as an impulse limit, a_p the particle's face)
-// by impulses λ_p on the nodes, Δv_i = ψ_i λ_p/m_i, and −λ_p/Δt on the body at x_p, found together by projected
-// Gauss–Seidel over the contacts in a fixed order (one thread: deterministic). Each update uses the effective
-// mass of its direction, 1/k = Σ_a e_a² Σ_i rd_i w_i/m_i + e·(W_B e) (W_B: a free body's inverse mass and inertia
-// at r_p, 0 if prescribed); a free body's velocity takes its share of every exchange. A layer of PtsContact over
-// the per-step state (Base: ContactDetection).
+// The kinematic contact law (ContactLaw::Kinematic, the default; doc/contact.md "Contact laws"): the Δt → 0 limit of
+// Eq. 23, reached at any Δt by constraining the velocities of the touching particles (no approach, Coulomb + cohesion
+// as an impulse limit, Eq. 24) with impulses found by projected Gauss–Seidel over the contacts in a fixed order (one
+// thread). A layer of PtsContact (Base: ContactDetection); the derivation: doc/developer/core_notes.md.
 #pragma once
 #include "ContactDetection.hpp"
 
@@ -209,13 +202,13 @@ private:
 				Vec         vp = Vec::Zero();
 				for (int k = 0; k < c.nn; ++k)
 					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * grid.vel[c.node[k]].c[a];
-				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r);
+				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r); // u_p = v_p − (v + ω × r_p), Eqs. 6, 26
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal
 				const Real kinvN = compliance(c, q, c.n);
 				if (!(kinvN > 0)) continue; // every stencil component held by boundary planes
 				const Real ln0 = c.lam.dot(c.n);
-				const Real ln  = std::max(Real(0), ln0 + (c.g - u.dot(c.n)) / kinvN);
+				const Real ln  = std::max(Real(0), ln0 + (c.g - u.dot(c.n)) / kinvN); // u·n ≥ g_p, λ_n ≥ 0
 				// tangential: stop the slip with the effective mass of its direction
 				const Vec  lt0 = c.lam - ln0 * c.n;
 				const Vec  ut  = u - u.dot(c.n) * c.n;
@@ -225,7 +218,7 @@ private:
 					const Real kinvT = compliance(c, q, ut / utn);
 					if (kinvT > 0) lt -= ut / kinvT;
 				}
-				const Real cap = mu * ln + c.cap0;
+				const Real cap = mu * ln + c.cap0; // ‖λ_t‖ ≤ μ λ_n + c a_p Δt
 				const Real ltn = lt.norm();
 				if (ltn > cap) lt *= cap / ltn; // slip at the limit (Eq. 24)
 				const Vec lam = ln * c.n + lt;

@@ -1,12 +1,8 @@
-// The penalty contact law (ContactLaw::Penalty): paper Eqs. 23–26 as printed, for one contact group per call.
-//   1. particle pass: a particle with d_p − d0 < 0 gets f_p = −(1 − χ) κ_p (d_p − d0) n_p, κ_p = 2 m_p/Δt² (Eq. 23),
-//      spread to the nodes with ψ_i; the node's load N_i = Σ_p ŵ_i ‖f_p‖ and area A_i = Σ_p ŵ_i a_p (a_p the
-//      particle's face) with the B-spline weights normalised over the active nodes, ŵ_i = w_i / Σ_active w
-//   2. node pass: stick or slip against the body (Eqs. 24–26), a free body's motion after the step included
-//      (bodyResponse); v_i += Δt (f_nor + f_tan)/m_i
-//   3. reaction: the part owning the surface point nearest each node receives −(f_nor + f_tan), in node order
-// Called by every thread of the step's parallel region; every sum has a fixed order (block colours, node order):
-// the same bits for any thread count. A layer of PtsContact over the per-step state (Base: ContactDetection).
+// The penalty contact law (ContactLaw::Penalty, paper Eqs. 23–26 as printed), one group per call: 1. the particle
+// pass spreads the normal penalty force of Eq. 23 to the nodes, 2. the node pass sticks or slips each contact node
+// against the body (Eqs. 24–26, a free body's motion after the step included), 3. the reactions on the parts.
+// Every thread of the step's region calls it; the sums have a fixed order. A layer of PtsContact (Base:
+// ContactDetection); the reasoning behind N_i, A_i and the free-body stick step: doc/developer/core_notes.md.
 #pragma once
 #include "ContactDetection.hpp"
 

@@ -1,13 +1,8 @@
-// The contact phase of the step (paper Sec. 2.3, Eqs. 23–26; Fig. 1b): particle-to-surface (PTS) frictional
-// contact between the MPM particles and rigid surfaces, group by group with each group's law (penalty:
-// PenaltyContact.hpp, kinematic: KinematicContact.hpp). The solver calls it only when active():
-//   beforeTransfer  serial, before P2G: world geometry, covered nodes excluded (ContactDetection.hpp)
-//   apply           every thread of the step's parallel region, between gridUpdate and g2p: corrects Grid::vel,
-//                   writes the nodal contact forces (ContactNodes::force) and sums the body reactions
-//   reproject       every thread, after the late damping (dampAfterContact): the kinematic groups again
-// Nothing here throws inside the region (failures go to ContactStep::err), every node is written by one thread
-// and every sum has a fixed order: the results are the same bits for any thread count. The exchange policy of
-// the ContactStep (core/Exchange.hpp) carries the sums a distributed run shares between its processes.
+// The contact phase of the step (paper Sec. 2.3, Eqs. 23–26; Fig. 1b): particle-to-surface (PTS) frictional contact
+// of the particles with rigid surfaces, group by group with each group's law. beforeTransfer (serial, before P2G)
+// places the bodies and excludes the nodes they cover; apply (every thread, between gridUpdate and g2p) corrects the
+// nodal velocities and sums the reactions; reproject (after the late damping) runs the kinematic groups again.
+// The ContactStep's exchange policy (core/Exchange.hpp) carries what a distributed run shares.
 #pragma once
 #include "KinematicContact.hpp"
 #include "PenaltyContact.hpp"

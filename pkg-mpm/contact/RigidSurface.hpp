@@ -1,17 +1,7 @@
-// Rigid surfaces with kinematics, for PTS contact (paper Sec. 2.3). No YADE dependency: a YADE body is
-// a `RigidPart` (centre c, rotation R, velocity v, angular velocity ω, and the reaction force/torque it
-// receives), its shape is a set of primitives expressed in the part's own frame:
-//   BoxPrim    oriented box (2D: rectangle, the trace of a box at z = 0)
-//   PlanePrim  plane; one-sided (half-space behind the normal, a YADE Wall with sense ±1) or two-sided
-//   SpherePrim sphere (3D) or circle (2D: the trace of a YADE sphere at z = 0); a free DEM sphere is one
-//              part with one circle, a clump of spheres one part with one circle per member
-//   element    segment (2D, trace of a facet at z = 0) or triangle (3D) of a surface mesh; a set of
-//              elements that closes (every edge shared by two triangles / every vertex by two segments)
-//              bounds a volume and gets a signed distance (a closed prism of facets), else it is a thin
-//              two-sided surface.
-// A `RigidGroup` is what contact sees: the union of the primitives of one or more parts, sharing one set
-// of contact parameters. `query(x)` gives the signed distance (> 0 outside), the outward unit normal at
-// the closest surface point and the part owning that point; `velocityAt(part, x)` = v + ω × (x − c).
+// Rigid surfaces with kinematics for the PTS contact (paper Sec. 2.3), without YADE dependency: a YADE body is a
+// RigidPart (pose, velocity, the reaction it receives), its shape primitives (box, plane, sphere/circle, surface
+// elements) live in the part's frame, and a RigidGroup, the union of the primitives of one or more parts with one
+// set of contact parameters, answers query(x): signed distance (> 0 outside), outward normal, owning part.
 #pragma once
 #include "ContactParams.hpp"
 #include "../core/MpmTypes.hpp"
@@ -50,7 +40,7 @@ struct RigidPart {
 	SpinOf<D>  w = SpinOf<D>::Zero();     // angular velocity [rad/s]
 	Vec        force  = Vec::Zero();      // reaction from the MPM grid in the last step [N] (2D: N per m)
 	SpinOf<D>  torque = SpinOf<D>::Zero(); // its moment about c [N m] (2D: N m per m)
-	// The body's inertia as the stick step of Eq. 24 sees it (PtsContact::bodyResponse: the body's motion after the step):
+	// The body's inertia as the stick step of Eq. 24 sees it (PenaltyContact::bodyResponse: the body's motion after the step):
 	// mass [kg] (2D: kg per m of thickness), in (0, inf]; inf (default) = immovable along its translations
 	// (a prescribed body: blocked DOFs, not dynamic), which gives the paper's stick step unchanged.
 	Real       mass    = INFINITY;
@@ -88,7 +78,7 @@ struct RigidPart {
 };
 
 template <int D>
-struct BoxPrim {
+struct BoxPrim { // oriented box (2D: a rectangle, the trace of a box at z = 0)
 	using Vec = typename Dim<D>::Vec;
 	using Mat = typename Dim<D>::Mat;
 	int part;
@@ -98,7 +88,7 @@ struct BoxPrim {
 	Mat R;      // world orientation (updated)
 };
 template <int D>
-struct PlanePrim {
+struct PlanePrim { // one-sided (the half-space behind n, a YADE Wall) or two-sided plane
 	using Vec = typename Dim<D>::Vec;
 	int  part;
 	Vec  pL, nL;  // point and unit normal in the part frame
@@ -107,7 +97,7 @@ struct PlanePrim {
 };
 
 template <int D>
-struct SpherePrim {
+struct SpherePrim { // sphere (3D) or circle (2D: the trace at z = 0); a clump: one per member
 	using Vec = typename Dim<D>::Vec;
 	int  part;
 	Vec  cL; // centre in the part frame
@@ -127,12 +117,12 @@ struct RigidGroup {
 	std::vector<PlanePrim<D>> planes;
 	std::vector<SpherePrim<D>> spheres;
 	bool                     enabled = true; // false: skipped entirely this step (a DEM sphere far from the particles)
-	std::vector<Vec>         elemL;    // element vertices in their part's frame, NV per element
+	std::vector<Vec>         elemL;    // segment (2D) / triangle (3D) vertices in their part's frame, NV per element
 	std::vector<int>         elemPart; // owning part of each element
 	std::vector<Vec>         elem;     // world vertices (updated)
-	bool                     closed = false; // the elements bound a volume (decided once, from the first pose)
+	bool                     closed = false; // the elements bound a volume: signed distance (else a thin two-sided surface)
 	// d0 = "initial" only (params.initialD0): d0 [m] per stable particle id, NaN = the default ½ V_p^{1/D};
-	// empty until captured (PtsContact::captureInitialD0). d0InitialMax: the largest captured value.
+	// empty until captured (ContactGroups::captureInitialD0). d0InitialMax: the largest captured value.
 	std::vector<Real>        d0Initial;
 	Real                     d0InitialMax = 0;
 	bool                     d0Captured   = false;

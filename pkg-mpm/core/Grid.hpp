@@ -1,25 +1,6 @@
-// Fixed regular background grid (Eulerian nodes) with boundary planes and a composable node-exclusion mask.
-// Two ghost layers on every side keep every cubic-B-spline stencil inside the arrays, so kernels never
-// branch on array bounds: ghost nodes are simply excluded from the WLS fit (ψ_i = 0 there).
-//
-// Node exclusion (`excluded`, one byte per node, doc/boundaries.md): a node with ANY bit set is left out of
-// every WLS fit. The bits are independent, so each owner sets and clears only its own:
-//   ExGhost   stored node outside the physical grid (not an image of a symmetry plane)   Grid, static
-//   ExBeyond  strictly beyond a one-sided boundary plane ('fixed', 'slip-onesided')      Grid, from planes
-//   ExGap     thin gap between the faces of a flaw (yade_mpm.scene) or user exclusion   scene / user
-//   ExContact covered by a rigid body (Fig. 1b)                                          contact, every step
-// `stencilExcl[b]` counts the excluded nodes of the 4^D stencil whose first node is b, so "is any node of
-// this particle's stencil excluded" is one byte load (computeKernel). Change bits only through setBits /
-// clearBitEverywhere, which keep the counts and the images of symmetry planes consistent.
-//
-// Boundary planes (axis-aligned):
-//   Slip          symmetry plane by reflected images: the nodes within 2 cells beyond the plane carry the
-//                 mirror image of their partners (fold/unfold, MirrorPlanes.hpp), so every particle sees the
-//                 nodal field of the symmetric full-space problem. Position on a node line or halfway between two.
-//   Fixed         one-sided WLS: nodes strictly beyond are excluded (ExBeyond), nodes on the plane have all
-//                 velocity components zero; the WLS fit over the active nodes is exact for linear fields that
-//                 vanish on the plane. Position on a node line.
-//   SlipOneSided  as Fixed but only the normal component is zero on the plane (kept to compare costs).
+// The fixed regular background grid (Eulerian nodes, two ghost layers on every side so that every cubic-B-spline
+// stencil stays inside the arrays), its axis-aligned boundary planes and the node-exclusion mask: a node with any
+// exclusion bit set is left out of every WLS fit (doc/boundaries.md).
 #pragma once
 #include "MirrorPlanes.hpp"
 #include <algorithm>
@@ -27,9 +8,17 @@
 
 namespace mpm {
 
+// Fixed: one-sided WLS, nodes beyond excluded, all components zero on the plane (on a node line). Slip: symmetry
+// plane by reflected images (MirrorPlanes.hpp; on a node line or halfway). SlipOneSided: as Fixed, normal only.
 enum class BoundaryKind : int { Fixed = 0, Slip = 1, SlipOneSided = 2 };
 
-enum ExclusionBit : uint8_t { ExGhost = 1, ExBeyond = 2, ExGap = 4, ExContact = 8 };
+// Independent bits, each set and cleared by its owner only, through setBits (keeps stencilExcl and the images).
+enum ExclusionBit : uint8_t {
+	ExGhost   = 1, // stored node outside the physical grid, not an image of a symmetry plane (Grid)
+	ExBeyond  = 2, // strictly beyond a one-sided plane, 'fixed' or 'slip-onesided' (Grid, from the planes)
+	ExGap     = 4, // thin gap between the faces of a flaw (yade_mpm.scene) or user exclusion
+	ExContact = 8  // covered by a rigid body (Fig. 1b; the contact phase, every step)
+};
 
 template <int D>
 struct BoundaryPlane {
@@ -57,7 +46,7 @@ struct Grid {
 	std::vector<NodeVec<D>> vmusl; // gridMusl: MUSL velocity, Eqs. 16–17
 	std::vector<uint8_t> fixMask;     // bit a set: velocity component a is prescribed zero
 	std::vector<uint8_t> excluded;    // exclusion bits (ExclusionBit); any bit → left out of the WLS fits
-	std::vector<uint8_t> stencilExcl; // number of excluded nodes in the 4^D stencil starting at this node
+	std::vector<uint8_t> stencilExcl; // excluded nodes in the 4^D stencil starting at this node (one load per kernel)
 	std::vector<BoundaryPlane<D>> planes;
 	Vec allowedLo, allowedHi; // particles must stay in [allowedLo, allowedHi): the physical grid cut by the planes
 

@@ -1,16 +1,6 @@
-// Grid node data, one array per quantity as the step's phases produce them (paper Fig. 2):
-//
-//   nodes  Node<D>      P2G: lumped mass m (Eq. 20), Shepard mass mw = Σ w m (Eq. 17 denominator),
-//                       momentum p (Eq. 20) and force f (Eqs. 21–22); without damping p holds p + Δt f
-//                       (Eq. 18's numerator, summed by P2G directly) and f stays 0 (Transfer::p2g)
-//   vel    NodeVec<D>   gridUpdate: updated velocity (Eq. 18), corrected by the contact (Eqs. 23–26)
-//   mom    NodeVec<D>   G2P: MUSL momentum Σ w m h_p(x_i) (Eq. 16 numerator)
-//   vmusl  NodeVec<D>   gridMusl: MUSL velocity (Eqs. 16–17), read by the stress pass (Eq. 7)
-//
-// A Node fills one 64-byte cache line (2D: 6 values + 2 padding lanes, 3D: 8), so P2G updates a whole
-// node with one 8-lane vector operation (2D without damping: the 4 lanes m, mw, p + Δt f). A NodeVec holds D components (3D: + 1 padding lane), so the 4
-// nodes of a stencil row along x are one (2D) or two (3D) contiguous 8-lane vectors for the gathers
-// and the MUSL scatter (Lanes.hpp).
+// The data of a grid node (paper Fig. 2): Node<D>, what P2G sums (one 64-byte cache line, updated as one 8-lane
+// vector), and NodeVec<D>, a nodal vector (velocity, MUSL momentum, MUSL velocity; 4 of them fill one or two lane
+// vectors along a stencil row). The arrays and the phase that writes each: Grid.hpp.
 #pragma once
 #include "MpmTypes.hpp"
 
@@ -18,9 +8,9 @@ namespace mpm {
 
 template <int D>
 struct alignas(64) Node {
-	Real m, mw;
-	Real p[D]; // momentum
-	Real f[D]; // force
+	Real m, mw;   // lumped mass (Eq. 20), Shepard mass Σ w m (Eq. 17 denominator)
+	Real p[D];    // momentum (Eq. 20); without damping p + Δt f, Eq. 18's numerator summed by P2G (Transfer::p2g)
+	Real f[D];    // force (Eqs. 21–22); 0 without damping (then in p)
 };
 // Lane vectors of doubles alias doubles (GCC gives a vector type its element's alias set), not the pointers
 // of the particle arrays: no may_alias, so stores to nodes do not force the array pointers to be reloaded.

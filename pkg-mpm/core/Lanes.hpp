@@ -1,10 +1,6 @@
-// Node-lane arithmetic and stencil walks shared by the transfers (Transfer.hpp).
-//
-// Interior particles (all 4^D stencil nodes active) have ψ_i = w_i and ∇ψ_i = w_i·3/l²·(x_i − x_p)
-// (WlsShape.hpp), so a transfer to or from the stencil is a tensor product: forRows visits the 4^(D−1)
-// rows along x and the kernels update whole nodes as 8-lane vectors (one cache line, Grid.hpp).
-// Particles with a reduced node set (grid edge, excluded nodes) go through forStencil with the full
-// WLS ψ_i, ∇ψ_i of fillStencil.
+// Node-lane arithmetic and stencil walks shared by the transfers (Transfer.hpp). An interior particle (ψ_i = w_i,
+// ∇ψ_i = w_i·3/l²·(x_i − x_p), WlsShape.hpp) is a tensor product: forRows visits the 4^(D−1) rows along x and the
+// kernels update whole nodes as lane vectors; a particle with a reduced node set goes through forStencil.
 #pragma once
 #include "WlsShape.hpp"
 #include <immintrin.h>
@@ -95,7 +91,7 @@ struct PackedRow {
 	// A node vector repeated in every node slot of a row (padding lanes 0).
 	static RowLanes spread(const Real* v)
 	{
-#ifdef __AVX512F__ // one broadcast from registers (a vector built on the stack stalls on store forwarding)
+#ifdef __AVX512F__ // one broadcast from registers
 		if constexpr (S == 2) return RowLanes(_mm512_broadcast_f64x2(_mm_set_pd(v[1], v[0])));
 		else return RowLanes(_mm512_broadcast_f64x4(_mm256_set_pd(0.0, v[2], v[1], v[0])));
 #endif

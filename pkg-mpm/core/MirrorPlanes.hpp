@@ -1,16 +1,7 @@
-// Symmetry ('slip') boundary planes by reflected images (doc/boundaries.md).
-//
-// A particle next to a symmetry plane has a reflected image beyond it. The image's contribution to node k
-// equals the reflection of the particle's own contribution to the partner node k' = twoP − k (cubic
-// B-splines are even; mass and the tangential components are even, the normal components odd), so after a
-// scatter every node on the material side within 2 cells adds the reflected content of its partner
-// (fold), and afterwards every node beyond takes the reflection of its partner (unfold): the nodal field
-// is then exactly that of the mirror-symmetric full-space problem (exact for uniform states and linear
-// fields; interior closed-form stencils).
-// fold/unfold are orphaned OpenMP loops over the node lines along the plane's axis (called inside the
-// step's parallel region; each line is handled by one thread in a fixed order → bitwise identical
-// results for any thread count). Planes are folded in order and unfolded in reverse order, so corners of
-// two planes get all reflected images. Node coordinates here are stored (ghost-shifted) indices.
+// Symmetry ('slip') boundary planes by reflected images (doc/boundaries.md): after a scatter the nodes within
+// 2 cells on the material side add their partner's reflected content (fold), after a nodal update the nodes beyond
+// take their partner's reflection (unfold), so the nodal field is that of the mirror-symmetric full-space problem.
+// fold/unfold are orphaned OpenMP loops inside the step's region. Coordinates are stored (ghost-shifted) indices.
 #pragma once
 #include "GridNode.hpp"
 #include <vector>
@@ -179,9 +170,8 @@ public:
 
 private:
 	std::vector<Mirror> list;
-	// Consecutive planes along the same axis (the two sides of a block, ≥ 2 cells apart) touch disjoint
-	// node lines in fold and unfold except for adding to the same node in plane order, so they share one
-	// loop over the node lines (one barrier per pass): bitwise the same as plane after plane.
+	// Consecutive planes along the same axis (≥ 2 cells apart) share one loop over the node lines (one barrier
+	// per pass): bitwise the same as plane after plane.
 	struct Group {
 		size_t    first; // its first plane in list (columns, stride)
 		int       n;     // (k, kp) pairs of all its planes, in plane order

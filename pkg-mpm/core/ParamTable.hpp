@@ -12,7 +12,7 @@
 // From the list, MPM_PARAMS(Struct, LIST) generates inside the struct:
 //   the plain fields (hot loops read them directly, no lookups), a static table of ParamInfo,
 //   forEachMember(f) visiting (info, member pointer) and validateParams() (range + required).
-// The binding layer (py/param_binding.hpp) generates Python properties with docstrings, typed
+// The binding layer (python/param_binding.hpp) generates Python properties with docstrings, typed
 // setters, keyword constructors and toDict/fromDict from the same table.
 #pragma once
 #include "MpmTypes.hpp"

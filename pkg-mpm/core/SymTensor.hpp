@@ -140,11 +140,8 @@ inline Real maxPrincipal(const Sym<D>& s)
 	}
 }
 
-// Whether σ may have a tensile principal value (σ1 > 0), without a root or a decomposition: in 2D exactly
-// max(a + √(b² + τ²), σzz) > 0 with a = (σxx + σyy)/2, b = (σxx − σyy)/2 (a + r > 0 ⇔ a > 0 or r² > a²); in 3D by
-// Gershgorin's bound σ1 ≤ maxᵢ(σᵢᵢ + Σⱼ≠ᵢ |σᵢⱼ|), so false means σ1 ≤ 0 and true may still be compression. The
-// damage model (Eqs. 35–40) acts on tension only; most rock in a loaded scene is compressed, so this test
-// spares it the decomposition (issue 19).
+// Whether σ may have a tensile principal value (σ1 > 0), without a root or a decomposition: exact in 2D
+// (a + r > 0 ⇔ a > 0 or r² > a²), Gershgorin's bound in 3D (false: σ1 ≤ 0; true may still be compression).
 template <int D>
 inline bool mayBeTensile(const Sym<D>& s)
 {

@@ -56,8 +56,8 @@ struct Kernel {
 	bool   inside;  // x is finite and inside the physical grid (false: nothing else is valid)
 };
 
-// The grid constants a kernel evaluation reads, copied once per pass into a local: the Grid fields are doubles,
-// so after every store to a particle array the compiler would reload them and redo the divisions per particle.
+// The grid constants a kernel evaluation reads, copied once per pass into a local (so that stores to the particle
+// arrays do not force them to be reloaded and the divisions redone per particle).
 template <int D>
 struct KernelGeom {
 	Real           origin[D], cells[D]; // [m], physical cells per axis
@@ -131,8 +131,7 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 
 	// General case: moment matrix over active nodes (Eq. 10), basis p = [1, (x_i − x_p)/l] for conditioning.
 	using MatP = Eigen::Matrix<Real, D + 1, D + 1>;
-	// Scalar code: p_n is rebuilt from st.d where needed (a basis vector stored element by element and read back as
-	// one vector by Eigen stalled on store forwarding: a third of fillStencil's samples); an excluded node adds w = 0.
+	// Scalar code, p_n rebuilt from st.d where needed (faster than a stored basis vector); an excluded node adds w = 0.
 	auto basis = [&](int n, Real (&pn)[D + 1]) {
 		pn[0] = 1;
 		for (int a = 0; a < D; ++a) pn[a + 1] = st.d[a][Stencil<D>::along(n, a)] * invH;
@@ -169,18 +168,9 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 		st.psi[n] = st.w[n] * q[0];
 		for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
 	}
-	// Lumping weights of a cut stencil. ψ_i extrapolates beyond the active nodes (ψ up to 1 + t and −t), so the
-	// row-sum lumped mass Σ_p m_p ψ_i of Eq. 20 can be negative or vanish next to excluded nodes, and a node of
-	// negative mass accelerates against its force (the corner-particle blow-up next to a body). The paper's lumping
-	// is meant to be positive (text after Eq. 22, Hinton et al. 1976). Mass, momentum and external forces are lumped
-	// with η_i = ½ (w_i/Σ_active w + ψ⁺_i/Σ_j ψ⁺_j) ≥ 0, ψ⁺ = max(ψ, 0) (Σ η = 1: mass and momentum conserved;
-	// = ψ_i = w_i for a full stencil, Eq. 20 unchanged). The first half (Shepard weights, as the MUSL remap, Eq. 17)
-	// gives every node the particle touches a mass ≥ ½ ξ_i m_p: none vanishes. The second half is Eq. 20's own
-	// weights without their negative parts: a node on which the one-sided fit leans (ψ_i ≫ ξ_i) gets at least half the
-	// share of the particle's mass that it takes of its forces (penalty Eq. 23 with ψ_i, internal force Eq. 21 with
-	// ∇ψ_i). With the Shepard weights alone such a node beside a block's corner, a small w_i and ψ_i = 0.6, carried a
-	// tiny mass and a large force: a local mode at (ωΔt)² ≈ 3 of the explicit limit 4 (doc/contact.md, "Contact
-	// wherever the grid cuts a body"). ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).
+	// Lumping weights of a cut stencil (mass, momentum, external force; Eq. 20 with positive weights):
+	// η_i = ½ (w_i/Σ_active w + ψ⁺_i/Σ_j ψ⁺_j) ≥ 0, ψ⁺ = max(ψ, 0), Σ η = 1; ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).
+	// Why not ψ_i itself (a negative lumped mass next to excluded nodes): doc/developer/core_notes.md.
 	Real wsum = 0, psum = 0;
 	for (int n = 0; n < N; ++n) wsum += st.w[n], psum += std::max(st.psi[n], Real(0));
 	for (int a = 0; a < D; ++a) st.dbar[a] = 0;

@@ -43,8 +43,7 @@ MPM_CHOICES(PlasticStrainIncrement, "reference-code|von-mises")
 	X(Real, density, MPM_REQUIRED, "kg/m³", 0, INFINITY, OO, "ρ", "mass density (particle mass m_p = ρV_p)", \
 	  "Eq. 20", "")
 
-// Weibull m: rocks and ceramics lie between ~3 and ~40 (Grady & Kipp 1980); below 1 the flaw
-// population is degenerate and ε_D⁰ = (Vk)^(−1/m) under/overflows (m = 1e-300 gave ε_D⁰ = 0).
+// Weibull m in [1, 50]: rocks and ceramics lie between ~3 and ~40 (Grady & Kipp 1980); below 1 ε_D⁰ under/overflows.
 #define MPM_DPGK_PARAMS(X)                                                                                                        \
 	X(bool, plasticity, true, "-", 0, 1, CC, "", "Drucker–Prager return mapping on/off", "Eqs. 30–34", "")                       \
 	X(bool, damage, true, "-", 0, 1, CC, "", "Grady–Kipp tensile damage on/off", "Eqs. 35–40", "")                               \

@@ -1,13 +1,7 @@
-// MPI domain decomposition of one scene (MPI build only, module yade_mpm._core_mpi; doc/scaling.md).
-// Every rank runs the same script and builds the same scene; at the first step each rank keeps the
-// particles of its slab (SlabLayout: whole block layers along the last axis, boundaries from the particle
-// counts) and drops the others. From then on:
-//   re-sort      particles whose block layer belongs to a neighbour migrate to it with all their fields
-//                (before the counting sort; a re-sort is triggered on every rank when one needs it)
-//   P2G, G2P     partial sums of the shared node bands exchanged and added (HaloExchange.hpp)
-//   Δt           ρ_min, max ‖v‖ and the mass floor are global (min / max over ranks): the same Δt everywhere
-//   failures     a phase that failed on one rank stops every rank at the same point
-// Each rank holds the whole grid arrays but its particles touch only its reach (SlabLayout::reachedLayers).
+// MPI domain decomposition of one scene (MPI build only, module yade_mpm._core_mpi; doc/scaling.md). Every rank
+// builds the same scene; at the first step each keeps the particles of its slab (SlabLayout) and drops the others.
+// Then: particles migrate to the rank of their block layer at each re-sort, the shared node bands are summed
+// (HaloExchange), the Δt limits are global, and a phase that failed on one rank stops every rank.
 #pragma once
 #include "HaloExchange.hpp"
 
@@ -185,7 +179,7 @@ public:
 		if (distributed()) Comm::sum(&v, 1);
 		return v;
 	}
-	// Sums over nodes (body reactions, PtsContact): node i is counted by one rank, the owner of the block layer
+	// Sums over nodes (body reactions, PenaltyContact): node i is counted by one rank, the owner of the block layer
 	// of the cells above it (the nodes [ownedLo, ownedHi) of the slab; the ghost layers go to the end ranks).
 	bool ownsNode(size_t i) const { return !decomposed || (i >= ownedLo && i < ownedHi); }
 	// v ← the sum of every rank's v in rank order (the same bits on every rank); called by one thread.

@@ -1,13 +1,7 @@
-// Sums of the node layers two ranks share (MPI build only; SlabLayout.hpp, doc/scaling.md). After a
-// scatter (P2G: nodes, Eqs. 20–22; G2P: the MUSL momentum mom, Eq. 16) each rank holds partial sums from
-// its own particles; both neighbours send their partial sums of the shared band and add the other's, so
-// both hold a + b, the same bits (IEEE addition is commutative; a node is shared by two ranks at most).
-// The grid update (Eq. 18) and the MUSL velocity (Eq. 17) then run on each rank's copy of the band with
-// the same inputs and give the same values: no second exchange before G2P or the stress update.
-//
-// The exchange is called by every thread of the step's parallel region; one thread communicates
-// (MPI_THREAD_FUNNELED) between two barriers. It also agrees on failures: if the scatter failed on any
-// rank, every rank's ErrorRecord holds a failure afterwards and all ranks stop the step together.
+// Sums of the node layers two ranks share (MPI build only; doc/scaling.md): after a scatter (P2G, Eqs. 20–22; G2P,
+// Eq. 16) both neighbours send their partial sums of the shared band and add the other's, so both hold a + b, the
+// same bits, and the nodal updates (Eqs. 17–18) need no second exchange. Called by every thread of the step's
+// region; the master thread communicates (MPI_THREAD_FUNNELED); a failure on any rank reaches every rank.
 #pragma once
 #include "MpiComm.hpp"
 #include "SlabLayout.hpp"
@@ -32,7 +26,7 @@ public:
 		const Span s { reinterpret_cast<double*>(field.data()), sizeof(E) / sizeof(double) }; // E is a plain array of doubles
 		sumSpans(L, g, rank, &s, 1, err, phase);
 	}
-	// The same for n node arrays in one message per neighbour (e.g. the contact arrays of PtsContact).
+	// The same for n node arrays in one message per neighbour (e.g. the contact arrays of PenaltyContact).
 	void sumSpans(const SlabLayout<D>& L, const Grid<D>& g, int rank, const Span* s, int n, ErrorRecord& err, const char* phase)
 	{
 #pragma omp barrier

@@ -1,7 +1,7 @@
 // The MPI layer of the distributed build (module yade_mpm._core_mpi, compiled with -DMPM_MPI; doc/scaling.md).
 // Comm wraps the few MPI calls the decomposition needs (MPI_COMM_WORLD, called by one thread of a rank:
-// MPI_THREAD_FUNNELED). Reductions whose result enters the state are max/min (exact) or sums of integers
-// stored as doubles (exact), so every rank gets the same bits.
+// MPI_THREAD_FUNNELED). Reductions whose result enters the state are max (exact), sums of integers stored as
+// doubles (exact) or sums in rank order, so every rank gets the same bits.
 #pragma once
 #include "../core/MpmTypes.hpp"
 #include <algorithm>

@@ -1,9 +1,6 @@
-// The exchange policy of the MPI build (core/Exchange.hpp) over the ranks of the Solver's decomposition: the
-// shared node bands of the grid sums and of the contact sums are added like P2G's (HaloExchange), sums over
-// nodes count each node on its owner rank (Decomposition::ownsNode), and per-body sums are added over the ranks
-// in rank order (Decomposition::sumInRankOrder): every rank gets the same bits. The contact's sums are collective:
-// a group is skipped from its geometry alone on a distributed run (ContactDetection::beforeTransfer), so every
-// rank takes part, with or without particles near the body.
+// The exchange policy of the MPI build (core/Exchange.hpp) over the ranks of the Solver's decomposition: shared
+// node bands summed like P2G's (HaloExchange), each node counted on its owner rank in sums over nodes, per-body sums
+// added in rank order: every rank gets the same bits (doc/developer/core_notes.md, "The exchange policy").
 #pragma once
 #include "../core/Exchange.hpp"
 #include "Decomposition.hpp"

@@ -1,13 +1,7 @@
-// Which MPI rank owns which particles and nodes (doc/scaling.md). The domain is cut into slabs of whole
-// block layers (BlockSchedule: B cells per block edge) along the last axis (y in 2D, z in 3D): rank r owns
-// the block layers [first[r], first[r+1]) and their particles. Along that axis the stored node layers
-// are the slowest-varying index, so the nodes a rank touches are one contiguous index range.
-//
-// A particle of block layer c lies at (x − origin)/l ∈ [cB − margin, (c+1)B + margin) until the next re-sort
-// and its cubic stencil spans the nodes floor(·) − 1 … floor(·) + 2: the stored node layers a rank's
-// particles reach are [first[r]·B − margin − 1, first[r+1]·B + margin + 1] (+ ghost). Two neighbours
-// share the 2·margin + 3 = 5 layers around their common boundary; B > 2·margin + 2 keeps the shared bands
-// of one rank apart, so a node is shared by two ranks at most (its sum a + b is the same bits on both).
+// Which MPI rank owns which particles and nodes (doc/scaling.md): slabs of whole block layers along the last axis
+// (y in 2D, z in 3D), rank r owning the block layers [first[r], first[r+1]) and their particles; the nodes a rank
+// touches are one contiguous index range. Two neighbours share the 2·margin + 3 = 5 node layers around their
+// boundary (a particle drifts ≤ margin cells out of its block before a re-sort, its stencil spans 4 nodes).
 #pragma once
 #include "../core/BlockSchedule.hpp"
 #include <algorithm>

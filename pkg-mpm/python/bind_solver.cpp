@@ -29,7 +29,7 @@ struct SolverWrap {
 				                 + ParamInfo::num(o[a]) + " m, spacing " + ParamInfo::num(h) + " m)");
 			nodes *= n[a] + 1 + 2 * Grid<D>::ghost;
 		}
-		// Refuse a grid the machine cannot hold, with the numbers (was an empty MemoryError).
+		// Refuse a grid the machine cannot hold, with the numbers.
 		const double bytes = nodes * (sizeof(Node<D>) + 2), phys = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
 		if (bytes > phys)
 			throw InputError(who("cells") + ": a grid of " + ParamInfo::num(nodes) + " nodes needs " + ParamInfo::num(bytes / 1e9) + " GB, more than this machine's "

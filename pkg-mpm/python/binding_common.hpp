@@ -1,4 +1,4 @@
-// Shared by the binding files of the module yade_mpm._core (py/bindings.cpp and py/bind_*.cpp): the same
+// Shared by the binding files of the module yade_mpm._core (bindings.cpp and bind_*.cpp in pkg-mpm/python): the same
 // Boost.Python layer YADE uses. Each file exposes one concern; the Solver2D/3D class is created in
 // bind_solver.cpp and the others add their methods to it.
 #pragma once

@@ -16,8 +16,7 @@ PyObject* simulationErrorType = nullptr;
 void translateInput(const InputError& e) { PyErr_SetString(PyExc_ValueError, e.what()); }
 void translateSimulation(const SimulationError& e) { PyErr_SetString(simulationErrorType, e.what()); }
 
-// More threads than 4 per processor only add barrier overhead; far more crashed the process
-// (100000: a step segfaulted; 1000: libgomp aborted).
+// At most max(16, 4 × processors) threads (more only add barrier overhead; doc/developer/core_notes.md).
 int maxThreads() { return std::max(16, 4 * omp_get_num_procs()); }
 void setThreads(bp::object n) { omp_set_num_threads(int(argInt(n, "setThreads: threads", 1, maxThreads()))); }
 

@@ -10,8 +10,8 @@ inline Real cundallDamped(Real f, Real v, Real alpha) { return alpha > 0 && v !=
 
 // Nodal momentum balance with lumped mass (Eq. 18): v_i ← p_i/m_i + Δt f_i/m_i, with Cundall local
 // damping f ← f − α|f|sign(v) and the boundary planes (fixMask). Nodes lighter than massFloor carry no
-// velocity. Reads nodes (m, momentum p, force f; without damping P2G summed p + Δt f into p and f = 0); writes vel; clears mom (collects the MUSL momentum
-// next). keepOld: vold ← the velocity before the step (p_i/m_i), for dampAfterContact.
+// velocity. Reads nodes (m, p, f; without damping p holds p + Δt f and f = 0: GridNode.hpp); writes vel; clears mom
+// (G2P collects the MUSL momentum next). keepOld: vold ← the velocity before the step (p_i/m_i), for dampAfterContact.
 template <int D>
 inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, bool keepOld = false)
 {
@@ -37,10 +37,8 @@ inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, boo
 }
 
 // Damping of a scene with rigid bodies, after the contact step: the damped force is the node's net force
-// m (v_new − v_old)/Δt, contact forces included. Damping the force before contact (gridUpdate) takes
-// α|f| off a node whose internal force the contact then balances: next to a held platen the node is at
-// rest, sign(v) flips from step to step and the reaction (−Σ contact forces) swung to 0.79–1.41 of the
-// section force at α = 0.5. Reads vel (after contact) and vold (gridUpdate keepOld); writes vel.
+// m (v_new − v_old)/Δt, contact forces included (why: doc/developer/core_notes.md). Reads vel (after contact) and
+// vold (gridUpdate keepOld); writes vel.
 template <int D>
 inline void dampAfterContact(Grid<D>& grid, Real dt, Real damping, Real massFloor)
 {

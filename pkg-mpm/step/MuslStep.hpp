@@ -1,26 +1,7 @@
-// One explicit WLS-MPM step with MUSL (paper Sec. 2.5, Fig. 2), the whole step in order. Solver::advance
-// checks Δt, re-sorts the particles when due, marks the nodes covered by rigid bodies (Fig. 1b) and
-// calls gridPhases, then particlePhases; the loops live in the headers named on the right.
-//
-//   phase          what it computes                                             paper          where
-//   1 P2G          m_i = Σ η m_p, Σ w m_p, p_i = Σ η m_p h_p(x_i),              Eqs. 16, 20–22 Transfer::p2g
-//                  f_i = −Σ V_p σ_p ∇ψ_i + Σ η m_p g + traction
-//   2 grid update  v_i = (p_i + Δt f_i)/m_i, local damping, boundary planes     Eq. 18         gridUpdate
-//   3 contact      PTS correction of v_i by the rigid bodies, body reactions    Eqs. 23–26     ContactPhase::apply
-//   4 G2P          v_p = Σ η_i v_i, C_p = Σ v_i ⊗ ∇ψ_i;                         Eqs. 6–7       Transfer::g2p
-//                  MUSL momentum mom_i = Σ_p w m_p h_p(x_i)                     Eq. 16
-//   5 MUSL remap   ṽ_i = mom_i / Σ_p w m_p, boundary planes                     Eq. 17         gridMusl (below)
-//   6 stress       ∇ṽ_p = Σ ṽ_i ⊗ ∇ψ_i, Δε = sym(∇ṽ_p) Δt, Jaumann rotation,    Eqs. 7, 29,    updateStress,
-//                  material update, V_p ← det(I + Δt ∇ṽ_p) V_p                  27–40          Transfer::velocityGradient
-//   7 move         x_p ← x_p + Δt v_p, stability and re-sort checks                            moveParticles
-//
-// Each node array holds one quantity, written by one phase (Grid.hpp, GridNode.hpp):
-//   nodes {m, mw, p, f}  P2G (no damping: p + Δt f, f = 0)
-//       vel  grid update (+ contact)      mom  G2P      vmusl  MUSL remap
-// (gridUpdate also clears mom for G2P: one pass over the nodes.) With symmetry planes, nodal sums are
-// folded onto the physical nodes after each scatter and the nodes beyond the planes are filled again
-// after each nodal update (MirrorPlanes.hpp). h_p(x) = v_p + C_p (x − x_p): the particle's linear
-// velocity field (x̄_p for a cut stencil, WlsShape.hpp).
+// One explicit WLS-MPM step with MUSL (paper Sec. 2.5, Fig. 2), the whole step in order: gridPhases (1 P2G,
+// 2 grid update, 3 contact, 4 G2P, 5 MUSL remap, in one parallel region) and particlePhases (6 stress update,
+// 7 positions, in one loop over blocks); the loops live in the headers they call. A table of the phases, their
+// equations and the node arrays each writes: doc/developer/core_notes.md.
 #pragma once
 #include "../contact/PtsContact.hpp"
 #include "GridUpdate.hpp"
@@ -60,10 +41,9 @@ inline void stampTime(double& t)
 	t = omp_get_wtime();
 }
 
-// Phases 1–5 in one parallel region (the thread team is woken once per step, which matters on shared
-// cores): every thread calls each phase, whose worksharing loops end with a barrier, and every thread
-// takes the same branches. A phase that recorded a failure (errP2G, errContact, errG2P) ends the region;
-// the caller throws. t[1..4]: wall clock after P2G, grid update, contact, G2P + MUSL remap.
+// Phases 1–5 in one parallel region: every thread calls each phase (worksharing loops, each ending with a barrier)
+// and takes the same branches. A phase that recorded a failure (errP2G, cs.err, errG2P) ends the region; the
+// caller throws. t[1..4]: wall clock after P2G, grid update, contact, G2P + MUSL remap.
 // cs.exchange (core/Exchange.hpp) adds the other processes' partial sums of the shared nodes after each scatter.
 template <int D, class Contact, class Mat, class X>
 inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D, X>& cs, const Mat& mat, const StepInputs<D>& in,

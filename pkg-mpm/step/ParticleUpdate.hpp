@@ -12,8 +12,7 @@ namespace mpm {
 // after(b, v2max, drift) runs on it (the position update: one parallel loop, the block still in cache).
 // Returns the smallest dtDensity (for Δt) and what `after` reduced (max ‖v‖², drift). Failures (singular
 // fit, non-finite stress, inverted volume) are recorded in err; the caller throws.
-// The particle loop is kept as it is: the compiler's FMA contraction depends on its context, and moving
-// it (e.g. into a per-block function) changed plastic stresses in the last bit.
+// Keep the particle loop where it is: the compiler's FMA contraction depends on its context (bit-identical results).
 struct ParticleStepStats {
 	Real dtDensityMin = INFINITY, v2max = 0; // min dtDensity (MaterialSet.hpp: ρ, or ρ/M in a mixed scene), max ‖v‖²
 	int  drift  = 0;

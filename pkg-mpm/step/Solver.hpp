@@ -1,7 +1,5 @@
-// Explicit WLS-MPM with MUSL (paper Sec. 2.5, Fig. 2). The solver owns the state (grid, particles, block
-// schedule, contact phase, clock), checks what a step reads and runs it: the step itself, phase by phase
-// with the paper's equations, reads in one place, MuslStep.hpp (P2G → grid update → contact → G2P →
-// MUSL remap → stress update → positions).
+// Explicit WLS-MPM with MUSL (paper Sec. 2.5, Fig. 2). The solver owns the state (grid, particles, block schedule,
+// contact phase, clock), checks what a step reads and runs it; the step itself, phase by phase, is MuslStep.hpp.
 #pragma once
 #include "../core/Exchange.hpp"
 #include "../core/SolverSettings.hpp"
@@ -81,7 +79,7 @@ public:
 			materials[size_t(material)].dpgk.checkThresholds(vol, n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything is added
 		P.append(x, vol, mass, n, grid.origin, grid.upper(), uint8_t(material));
 		if (materials.anyDpgk()) {
-			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off (was left unallocated → segfault)
+			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off
 			materials.initDamageThresholds(P, old);
 		}
 		needSort = needCheck = true;

@@ -1,10 +1,7 @@
-// Particle ↔ grid transfers of one step (paper Sec. 2.5, Fig. 2): P2G (Eqs. 20–22), G2P with the MUSL
-// remap (Eqs. 6–7, 16–17) and the particle velocity gradient from the MUSL nodal velocities (Eq. 7).
-//
-// Scatters run colour by colour over the particle blocks of BlockSchedule (blocks of one colour never
-// share a node, each block is summed by one thread in particle order): nodal sums are bitwise the same
-// for any thread count. p2g and g2p are called by every thread of the solver's parallel region
-// (orphaned worksharing loops); failures are recorded in an ErrorRecord, never thrown inside the region.
+// Particle ↔ grid transfers of one step (paper Sec. 2.5, Fig. 2): P2G (Eqs. 20–22), G2P with the MUSL remap
+// (Eqs. 6–7, 16–17) and the particle velocity gradient from the MUSL nodal velocities (Eq. 7). Scatters run colour
+// by colour over the blocks of BlockSchedule (the same bits for any thread count); p2g and g2p are called by every
+// thread of the solver's parallel region and record failures in an ErrorRecord.
 #pragma once
 #include "../core/BlockSchedule.hpp"
 #include "Kinematics.hpp"
