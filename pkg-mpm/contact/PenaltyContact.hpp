@@ -33,7 +33,7 @@ public:
 		const Real   massFloor = s.massFloor;
 		const auto&  g         = groups[gi];
 		const auto&  wk        = work[gi];
-		const size_t nn   = Boxes::boxCount(wk.nlo, wk.nhi);
+		const size_t nn        = Boxes::boxCount(wk.nlo, wk.nhi);
 #pragma omp for schedule(static)
 		for (size_t j = 0; j < nn; ++j) {
 			size_t i = Boxes::boxNode(grid, wk.nlo, wk.nhi, j);
