@@ -1,6 +1,6 @@
 // C++ unit tests of the core that need no Python: WLS shape functions against the closed form and
 // linear reproduction, one DP return landing on the yield surface, and the threads' shares of the block colours.
-#include "Solver.hpp"
+#include "step/Solver.hpp"
 #include "Check.hpp"
 #include <cstdio>
 #include <random>

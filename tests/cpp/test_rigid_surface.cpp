@@ -2,7 +2,7 @@
 // normal of boxes checked against closed triangle / segment meshes of the same box (two independent
 // computations), planes, open surfaces, closedness detection, and the rigid velocity v + ω × (x − c)
 // against a finite difference of the moving body.
-#include "RigidSurface.hpp"
+#include "contact/RigidSurface.hpp"
 #include "Check.hpp"
 #include <cstdio>
 #include <random>

@@ -2,7 +2,7 @@
 // given counts, the owner of each block layer, and the node layers a rank's particles reach, checked
 // against a brute-force walk over particle positions (stencil nodes floor(f) − 1 … floor(f) + 2 of every
 // position a particle of the slab may take before a re-sort).
-#include "SlabLayout.hpp"
+#include "mpi/SlabLayout.hpp"
 #include "Check.hpp"
 #include <set>
 

@@ -1,0 +1,262 @@
+// The kinematic contact law (ContactLaw::Kinematic, the default; doc/contact.md "Contact laws"): the Δt → 0 limit of
+// Eq. 23, reached at any Δt by constraining the velocities of the touching particles (no approach, Coulomb + cohesion
+// as an impulse limit, Eq. 24) with impulses found by projected Gauss–Seidel over the contacts in a fixed order (one
+// thread). A layer of PtsContact (Base: ContactDetection); the derivation: doc/developer/core_notes.md.
+#pragma once
+#include "ContactDetection.hpp"
+
+namespace mpm {
+
+// Detection tolerance of the kinematic law, as a fraction of the particle's edge (ε_p above).
+constexpr Real kinematicTouch = 1e-3;
+// Projected Gauss–Seidel: at most this many sweeps over the contacts, fewer when the largest velocity
+// correction of a sweep falls below kinematicTol × (the largest relative speed of the first sweep + 1e-12 m/s).
+constexpr int  kinematicSweeps = 60;
+constexpr Real kinematicTol    = 1e-6;
+
+// One contacting particle of a kinematic group, its stencil resolved to nodes of the modelled region (symmetry
+// planes, Grid::mirrors): the particle reads v_i of a node beyond a plane as the reflection of its partner
+// (rd: Σ ψ_i sign_i over the stencil nodes i whose source is node[k]), and its impulse reaches node[k] as fold
+// sums it, from the particle and from its images (w: a node on a plane also takes its own reflection). Without
+// planes rd = w = ψ.
+template <int D>
+struct KinematicContactRec {
+	using Vec = typename Dim<D>::Vec;
+	static constexpr int N = Dim<D>::nStencil;
+	size_t node[N];  // distinct nodes of the modelled region (count nn)
+	Real   rd[N][D]; // per-axis weight of node[k] in the particle's velocity, v_p[a] = Σ_k rd[k][a] v[node k][a]
+	Real   w[N][D];  // per-axis weight of node[k] in the particle's impulse, Δv[node k][a] = w[k][a] λ[a]/m_k
+	Real   invM[N];  // 1/m of node[k] [1/kg]
+	int    nn;
+	int    part;
+	Vec    x, n, r;  // particle position, contact normal, lever arm x_p − c
+	Real   g;        // target normal rate (d0 − d_p)/Δt [m/s]
+	Real   cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
+	Vec    kinvAxis; // Σ_k rd[k][a] w[k][a]/m_k over the nodes whose component a is free [1/kg]
+	Vec    lam;      // impulse on the particle [N s]
+};
+
+template <int D, class Base>
+class KinematicContact : public Base {
+public:
+	using Vec   = typename Dim<D>::Vec;
+	using IVec  = typename Dim<D>::IVec;
+	using Boxes = GridBoxes<D>;
+	using Base::dq;
+	using Base::groups;
+	using Base::nodeArr;
+	using Base::parts;
+	using Base::work;
+	static constexpr int N = Dim<D>::nStencil;
+
+	// Group gi with the kinematic law: its contacts, impulses and reactions; one thread (the exchange's oneThread).
+	template <class X>
+	void applyKinematic(size_t gi, const ContactStep<D, X>& s)
+	{
+		collect(gi, s);
+		solve(s.grid, gi);
+		reactions(gi, s.dt, 1);
+	}
+	// After the late damping (dampAfterContact), one thread: the damped velocities meet the constraints again; the
+	// reactions are those of the total impulse.
+	void reprojectKinematic(Grid<D>& grid, size_t gi, Real dt)
+	{
+		reactions(gi, dt, -1);
+		solve(grid, gi);
+		reactions(gi, dt, 1);
+	}
+
+private:
+	std::vector<std::vector<KinematicContactRec<D>>> kcs; // per group: its contacts this step (capacity kept between steps)
+
+	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
+	static Vec bodyCompliance(const RigidPart<D>& q, const Vec& r, const Vec& e)
+	{
+		if (!q.movable()) return Vec::Zero();
+		return e / q.mass + crossSpin<D>(SpinOf<D>(q.inverseInertia() * momentOf<D>(r, e)), r);
+	}
+	// 1/k of an impulse along unit e at contact c: Σ_a e_a² kinvAxis[a] (Σ_k rd_k w_k/m_k, free components) + e·(W_B e).
+	static Real compliance(const KinematicContactRec<D>& c, const RigidPart<D>& q, const Vec& e)
+	{
+		Real k = 0;
+		for (int a = 0; a < D; ++a) k += e[a] * e[a] * c.kinvAxis[a];
+		return k + e.dot(bodyCompliance(q, c.r, e));
+	}
+
+	// 1. the contacting particles of the blocks near group gi's body, in block order
+	template <class X>
+	void collect(size_t gi, const ContactStep<D, X>& s)
+	{
+		Grid<D>&                 grid  = s.grid;
+		const Particles<D>&      P     = s.P;
+		const BlockSchedule<D>&  sched = s.sched;
+		const StencilOffsets<D>& offs  = s.offs;
+		const GroupWork<D>&      wk    = work[gi];
+		if (s.exchange.distributed()) {
+			s.err.record(0, "is in a scene with a kinematic contact group, which a distributed run does not support yet (use law='penalty')");
+			return;
+		}
+		if (kcs.size() < groups.size()) kcs.resize(groups.size());
+		const auto& g  = groups[gi];
+		auto&       kc = kcs[gi];
+		kc.clear();
+		auto&        A  = nodeArr; // the nodal contact forces of the box, filled by reactions
+		const size_t nb = Boxes::boxCount(wk.nlo, wk.nhi);
+		for (size_t j = 0; j < nb; ++j) {
+			const size_t i = Boxes::boxNode(grid, wk.nlo, wk.nhi, j);
+			for (int a = 0; a < D; ++a) A.force[a][i] = 0;
+		}
+		IVec b;
+		for (int a = 0; a < D; ++a) b[a] = wk.blo[a];
+		while (true) {
+			size_t bl = 0, st1 = 1;
+			for (int a = 0; a < D; ++a) bl += size_t(b[a]) * st1, st1 *= sched.nBlocks[a];
+			for (uint32_t p = sched.start[bl]; p < sched.start[bl + 1]; ++p) {
+				Vec x;
+				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
+				const Real e  = ContactGroups<D>::edgeOf(P.vol[p]);
+				const Real d0 = ContactDetection<D>::detectionDistance(g, P, p, e);
+				if (d0 > wk.reach) continue;
+				const auto h = g.query(x);
+				if (!(h.d - d0 < kinematicTouch * e)) continue;
+				Stencil<D> st;
+				if (!computeStencil(grid, offs, x.data(), st)) {
+					s.err.record(p, "is in contact with a rigid body but has too few active grid nodes for the WLS fit (penetrated the body?)");
+					continue;
+				}
+				KinematicContactRec<D> c;
+				c.nn       = 0;
+				auto entry = [&](size_t i) -> int { // node i's entry (−1: too light to carry a velocity)
+					if (!(grid.nodes[i].m > s.massFloor)) return -1;
+					int k = 0;
+					while (k < c.nn && c.node[k] != i) ++k; // a node reached twice (directly and as an image): one entry
+					if (k == c.nn) {
+						if (c.nn == N) return -1; // cannot happen: at most 4^D distinct nodes of the modelled region
+						c.node[k] = i, c.invM[k] = 1 / grid.nodes[i].m, ++c.nn;
+						for (int a = 0; a < D; ++a) c.rd[k][a] = c.w[k][a] = 0;
+					}
+					return k;
+				};
+				for (int n = 0; n < N; ++n) {
+					const Real psi = st.psi[n];
+					if (psi == 0) continue;
+					const size_t i = st.base + offs.off[n];
+					if (!grid.hasMirrors()) {
+						const int k = entry(i);
+						if (k >= 0)
+							for (int a = 0; a < D; ++a) c.rd[k][a] += psi, c.w[k][a] += psi;
+						continue;
+					}
+					int       sg[D];
+					const int k = entry(grid.mirrorSource(i, sg));
+					if (k >= 0)
+						for (int a = 0; a < D; ++a) c.rd[k][a] += sg[a] * psi;
+					grid.forMirrorReceivers(i, [&](size_t j, const int* sj) {
+						const int kj = entry(j);
+						if (kj >= 0)
+							for (int a = 0; a < D; ++a) c.w[kj][a] += sj[a] * psi;
+					});
+				}
+				if (c.nn == 0) continue;
+				c.part = g.parts.size() == 1 ? g.parts[0] : h.part;
+				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
+				// Σ rd·w/m over the free components of the nodes, per axis (a boundary plane holds a component)
+				for (int a = 0; a < D; ++a) c.kinvAxis[a] = 0;
+				for (int k = 0; k < c.nn; ++k)
+					for (int a = 0; a < D; ++a)
+						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.rd[k][a] * c.w[k][a] * c.invM[k];
+				c.g    = (d0 - h.d) / s.dt;
+				c.cap0 = g.params.cohesion * (P.vol[p] / e) * s.dt;
+				c.lam.setZero();
+				kc.push_back(c);
+			}
+			int a = 0;
+			for (; a < D; ++a) {
+				if (b[a] < wk.bhi[a]) {
+					++b[a];
+					break;
+				}
+				b[a] = wk.blo[a];
+			}
+			if (a == D) break;
+		}
+		for (const auto& c : kc) // nodes of the records outside the box (partners of images)
+			for (int k = 0; k < c.nn; ++k)
+				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] = 0;
+		for (int p : g.parts) dq[p] = BodyMotion<D> {};
+	}
+
+	// 2. projected Gauss–Seidel on the impulses of group gi (free parts' velocity changes in dq); continues from
+	// the impulses found so far, so a second call after the late damping restores the constraints.
+	void solve(Grid<D>& grid, size_t gi)
+	{
+		if (gi >= kcs.size()) return;
+		const auto& g     = groups[gi];
+		auto&       kc    = kcs[gi];
+		const Real  mu    = g.params.mu;
+		Real        scale = 0;
+		for (int sweep = 0; sweep < kinematicSweeps; ++sweep) {
+			Real worst = 0;
+			for (auto& c : kc) {
+				const auto& q  = parts[c.part];
+				Vec         vp = Vec::Zero();
+				for (int k = 0; k < c.nn; ++k)
+					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * grid.vel[c.node[k]].c[a];
+				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r); // u_p = v_p − (v + ω × r_p), Eqs. 6, 26
+				if (sweep == 0) scale = std::max(scale, u.norm());
+				// normal
+				const Real kinvN = compliance(c, q, c.n);
+				if (!(kinvN > 0)) continue; // every stencil component held by boundary planes
+				const Real ln0 = c.lam.dot(c.n);
+				const Real ln  = std::max(Real(0), ln0 + (c.g - u.dot(c.n)) / kinvN); // u·n ≥ g_p, λ_n ≥ 0
+				// tangential: stop the slip with the effective mass of its direction
+				const Vec  lt0 = c.lam - ln0 * c.n;
+				const Vec  ut  = u - u.dot(c.n) * c.n;
+				const Real utn = ut.norm();
+				Vec        lt  = lt0;
+				if (utn > 0) {
+					const Real kinvT = compliance(c, q, ut / utn);
+					if (kinvT > 0) lt -= ut / kinvT;
+				}
+				const Real cap = mu * ln + c.cap0; // ‖λ_t‖ ≤ μ λ_n + c a_p Δt
+				const Real ltn = lt.norm();
+				if (ltn > cap) lt *= cap / ltn; // slip at the limit (Eq. 24)
+				const Vec lam = ln * c.n + lt;
+				const Vec dl  = lam - c.lam;
+				if (dl.isZero(0)) continue;
+				c.lam = lam;
+				for (int k = 0; k < c.nn; ++k) {
+					const size_t  i   = c.node[k];
+					const uint8_t fix = grid.fixMask[i];
+					for (int a = 0; a < D; ++a)
+						if (!((fix >> a) & 1)) grid.vel[i].c[a] += c.w[k][a] * c.invM[k] * dl[a];
+				}
+				if (q.movable()) { // the free body takes −Δλ at x_p
+					dq[c.part].v -= dl / q.mass;
+					dq[c.part].w -= SpinOf<D>(q.inverseInertia() * momentOf<D>(c.r, dl));
+				}
+				worst = std::max(worst, dl.norm() * kinvN);
+			}
+			if (worst <= kinematicTol * (scale + 1e-12)) break;
+		}
+	}
+
+	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_k w_k ∘ λ/Δt, in contact order
+	// (sign −1 takes back what an earlier call reported, before the re-projection after the late damping).
+	void reactions(size_t gi, Real dt, int sign)
+	{
+		if (gi >= kcs.size()) return;
+		auto& A = nodeArr;
+		for (const auto& c : kcs[gi]) {
+			// the body takes −λ/Δt at x_p (its images' share is theirs); the nodal forces Σ_k w_k ∘ λ/Δt
+			const Vec f = (sign / dt) * c.lam;
+			for (int k = 0; k < c.nn; ++k)
+				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.w[k][a] * f[a];
+			auto& q = parts[c.part];
+			q.force -= f;
+			q.torque -= momentOf<D>(c.r, f);
+		}
+	}
+};
+
+} // namespace mpm

@@ -1,0 +1,274 @@
+// MPI domain decomposition of one scene (MPI build only, module yade_mpm._core_mpi; doc/scaling.md). Every rank
+// builds the same scene; at the first step each keeps the particles of its slab (SlabLayout) and drops the others.
+// Then: particles migrate to the rank of their block layer at each re-sort, the shared node bands are summed
+// (HaloExchange), the Δt limits are global, and a phase that failed on one rank stops every rank.
+#pragma once
+#include "HaloExchange.hpp"
+
+#ifdef MPM_MPI
+namespace mpm {
+
+template <int D>
+class Decomposition {
+public:
+	const int       rank = Comm::rank(), R = Comm::size();
+	SlabLayout<D>   layout;
+	HaloExchange<D> halo;
+	bool            decomposed = false;
+	size_t          migrated   = 0; // particles sent by this rank since the split
+
+	bool distributed() const { return R > 1; }
+	bool needsSplit() const { return R > 1 && !decomposed; } // the first step on > 1 rank always sorts (and splits)
+
+	// Refuses, before any work, what this build does not distribute yet (the same answer on every rank).
+	void checkStep(size_t liveViews) const
+	{
+		if (!distributed()) return;
+		if (liveViews)
+			throw InputError("MPI: " + std::to_string(liveViews) + " NumPy view(s) of the particle arrays are alive; particles migrate between ranks and the "
+			                 "arrays change length: delete the views before stepping (del v) and take new ones after");
+	}
+
+	// What needs the whole scene on every rank is refused once the ranks hold their own particles.
+	void refuseAfterSplit(const char* what) const
+	{
+		if (decomposed)
+			throw InputError(std::string("MPI: ") + what + " after the first step is not supported on " + std::to_string(R)
+			                 + " ranks: each rank holds only its slab's particles now (doc/scaling.md)");
+	}
+	// Checkpoint resume (py/yade_mpm/checkpoint.py) into the freshly built, replicated scene: the saved slab
+	// layout, and the particle arrays cut to the rank's saved count n (the caller then writes the saved values).
+	void restore(const Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n)
+	{
+		if (decomposed) throw InputError("MPI checkpoint resume: the solver has stepped already; load the checkpoint into the freshly built scene");
+		if (int(first.size()) != R + 1)
+			throw InputError("MPI checkpoint resume: the checkpoint's slab layout has " + std::to_string(int(first.size()) - 1) + " ranks, this run has " + std::to_string(R));
+		if (n > P.n) throw InputError("MPI checkpoint resume: " + std::to_string(n) + " particles saved on this rank, the scene has " + std::to_string(P.n));
+		SlabLayout<D> L;
+		L.first = first;
+		for (int r = 0; r < R; ++r)
+			if (!(first[size_t(r)] < first[size_t(r) + 1]) || first[0] != 0 || first[size_t(R)] != SlabLayout<D>::layers(g))
+				throw InputError("MPI checkpoint resume: the saved slab layout does not fit this grid");
+		L.checkMirrors(g);
+		layout = L;
+		std::vector<uint8_t> go(P.n, 0);
+		for (size_t p = n; p < P.n; ++p) go[p] = 1;
+		keep(P, go);
+		settle(g);
+	}
+	// Before the counting sort: the first call splits the (replicated) scene, later calls re-balance (when the
+	// busiest rank holds more than `threshold` × the mean particle count) and migrate.
+	void migrate(const Grid<D>& g, Particles<D>& P, Real threshold)
+	{
+		if (!distributed()) return;
+		if (!decomposed) return split(g, P);
+		if (!rebalance(g, P, threshold)) {
+			hop(g, P, true);
+			return;
+		}
+		// After a re-cut a particle may belong to a rank several slabs away: it hops one neighbour per pass
+		// (≤ R − 1 passes; every rank takes part in every pass, so none waits in a collective).
+		for (int pass = 0; pass < R - 1; ++pass)
+			if (!hop(g, P, false)) break;
+	}
+	size_t rebalances = 0;     // re-cuts of the slabs since the split
+	Real   imbalance  = 1;     // max / mean of the per-rank particle counts at the last re-sort (after any re-cut)
+
+	// Dynamic load balance (doc/scaling.md), at every re-sort: the particle counts per block layer are summed
+	// over the ranks (integers in doubles: exact, the same on every rank; one MPI_Allreduce of a few dozen
+	// doubles); when max/mean of the per-rank counts exceeds the threshold (inf: never), the slabs are cut
+	// again by the start rule (SlabLayout::balanced). A new cut that would put a
+	// symmetry plane across a slab boundary is not taken (the same answer on every rank). True if re-cut.
+	bool rebalance(const Grid<D>& g, const Particles<D>& P, Real threshold)
+	{
+		std::vector<double> count = layerCounts(g, P);
+		Comm::sum(count.data(), int(count.size()));
+		imbalance = imbalanceOf(layout, count);
+		if (!(imbalance > threshold)) return false;
+		SlabLayout<D> cut = SlabLayout<D>::balanced(count, R);
+		if (cut.first == layout.first) return false;
+		try {
+			cut.checkMirrors(g);
+		} catch (const InputError&) {
+			return false;
+		}
+		layout = cut;
+		settle(g);
+		imbalance = imbalanceOf(layout, count);
+		++rebalances;
+		return true;
+	}
+	// max / mean of the per-rank particle counts of a layout (1 for no particles).
+	Real imbalanceOf(const SlabLayout<D>& s, const std::vector<double>& count) const
+	{
+		double total = 0, most = 0;
+		for (int r = 0; r < R; ++r) {
+			double n = 0;
+			for (int c = s.first[size_t(r)]; c < s.first[size_t(r) + 1]; ++c) n += count[size_t(c)];
+			total += n, most = std::max(most, n);
+		}
+		return total > 0 ? most * R / total : 1;
+	}
+
+	// One migration pass: particles whose block layer belongs to another rank move one rank towards it.
+	// strict: a particle must not be more than one slab away (no re-cut since the last re-sort). Returns
+	// whether any particle on any rank moved.
+	bool hop(const Grid<D>& g, Particles<D>& P, bool strict)
+	{
+		std::vector<uint8_t> go(P.n, 0); // 0: stays, 1: to rank − 1, 2: to rank + 1
+		bool                 ok = true;
+		size_t               nd = 0, nu = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			const int o = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p]));
+			if (o == rank) continue;
+			ok = ok && (o == rank - 1 || o == rank + 1);
+			go[p] = o < rank ? 1 : 2;
+			(o < rank ? nd : nu) += 1;
+		}
+		if (strict && !Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
+		if (!strict && Comm::all(nd + nu == 0)) return false;
+		const size_t nf = fieldCount(P);
+		std::vector<double> sd, su, rd(1), ru(1), cd { double(nd) }, cu { double(nu) };
+		Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
+		const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
+		sd.reserve(nd * nf), su.reserve(nu * nf);
+		for (size_t p = 0; p < P.n; ++p)
+			if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
+		rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
+		Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
+		keep(P, go);
+		unpack(P, rd, ad, nf), unpack(P, ru, au, nf); // arrivals from below, then from above: a fixed order
+		migrated += nd + nu;
+		return true;
+	}
+
+	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.
+	void reduceLimits(Real& dtDensityMin, Real& vmax, Real& massFloor) const
+	{
+		if (!distributed()) return;
+		double v[3] = { -dtDensityMin, vmax, -massFloor };
+		Comm::max(v, 3);
+		dtDensityMin = -v[0], vmax = v[1], massFloor = -v[2];
+	}
+	// End of step: global ρ_min, max ‖v‖², re-sort flag, particles that left the grid; a failure of the particle pass on any rank stops all.
+	void reduceStep(Real& dtDensityMin, Real& v2max, int& drift, ErrorRecord& errStress, ErrorRecord& errMove) const
+	{
+		if (!distributed()) return;
+		double v[5] = { -dtDensityMin, v2max, double(drift), errStress.none() && errMove.none() ? 0.0 : 1.0, errMove.left.empty() ? 0.0 : 1.0 };
+		Comm::max(v, 5);
+		dtDensityMin = -v[0], v2max = v[1], drift = int(v[2]);
+		errMove.leftAnywhere = v[4] > 0; // a particle left the grid on some rank: every rank settles it (Solver::settleLeaving)
+		if (v[3] > 0 && errStress.none() && errMove.none())
+			errMove.record(ErrorRecord::elsewhere, "stopped: the stress or position update of another MPI rank failed (its message names the particle)");
+	}
+	// Runs a validation on every rank; if it threw on any, every rank throws (its own message or a pointer to it).
+	template <class F>
+	void agree(F&& validate) const
+	{
+		std::string bad;
+		try {
+			validate();
+		} catch (const InputError& e) {
+			bad = e.what();
+		}
+		if (Comm::all(bad.empty())) return;
+		throw InputError(bad.empty() ? "MPI: the particle check failed on another rank (its message names the particle)" : bad);
+	}
+	Real sum(Real v) const
+	{
+		if (distributed()) Comm::sum(&v, 1);
+		return v;
+	}
+	// Sums over nodes (body reactions, PenaltyContact): node i is counted by one rank, the owner of the block layer
+	// of the cells above it (the nodes [ownedLo, ownedHi) of the slab; the ghost layers go to the end ranks).
+	bool ownsNode(size_t i) const { return !decomposed || (i >= ownedLo && i < ownedHi); }
+	// v ← the sum of every rank's v in rank order (the same bits on every rank); called by one thread.
+	void sumInRankOrder(double* v, int n)
+	{
+		if (distributed()) Comm::sumInRankOrder(v, n, gathered);
+	}
+
+private:
+	// First step: the same particles on every rank (checked: count and a position checksum); slabs from
+	// the particle counts per block layer; each rank keeps its own.
+	void split(const Grid<D>& g, Particles<D>& P)
+	{
+		double s = 0;
+		for (size_t p = 0; p < P.n; ++p) s += P.x[D - 1][p] + 0.5 * P.x[0][p] + 1e-3 * double(P.id[p]);
+		double hiv[3] = { double(P.n), s, double(fieldCount(P)) }, lov[3] = { -hiv[0], -hiv[1], -hiv[2] };
+		Comm::max(hiv, 3), Comm::max(lov, 3);
+		if (hiv[0] != -lov[0] || hiv[1] != -lov[1] || hiv[2] != -lov[2])
+			throw InputError("MPI: every rank must build the same scene before the first step (the script runs on every rank); the ranks hold "
+			                 "different particles (counts " + fmtNum(-lov[0]) + " to " + fmtNum(hiv[0]) + ")");
+		layout = SlabLayout<D>::balanced(layerCounts(g, P), R); // the scene is replicated: local counts are global
+		layout.checkMirrors(g);
+		std::vector<uint8_t> go(P.n, 0);
+		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
+		keep(P, go);
+		settle(g);
+	}
+	void settle(const Grid<D>& g)
+	{
+		const int    ax = D - 1, B = SlabLayout<D>::B, gh = Grid<D>::ghost;
+		const size_t st = g.stride[ax];
+		ownedLo = rank == 0 ? 0 : size_t(layout.first[size_t(rank)] * B + gh) * st;
+		ownedHi = rank + 1 == R ? g.size() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
+		decomposed = true;
+	}
+	// This rank's particle count per block layer along the slab axis (the input of SlabLayout::balanced).
+	static std::vector<double> layerCounts(const Grid<D>& g, const Particles<D>& P)
+	{
+		std::vector<double> count(size_t(SlabLayout<D>::layers(g)), 0.0);
+		for (size_t p = 0; p < P.n; ++p) count[size_t(SlabLayout<D>::layerOf(g, P.x[D - 1][p]))] += 1;
+		return count;
+	}
+	size_t              ownedLo = 0, ownedHi = 0; // nodes counted by this rank in sums over nodes (ownsNode)
+	std::vector<double> gathered;                 // scratch of sumInRankOrder
+	static size_t fieldCount(Particles<D>& P)
+	{
+		size_t n = 2; // id, material
+		P.forEachRealField([&](std::vector<Real>&) { ++n; });
+		return n;
+	}
+	static void pack(Particles<D>& P, size_t p, std::vector<double>& buf)
+	{
+		P.forEachRealField([&](std::vector<Real>& f) { buf.push_back(f[p]); });
+		double id;
+		std::memcpy(&id, &P.id[p], sizeof id); // the 64 bits as they are
+		buf.push_back(id), buf.push_back(double(P.mat[p]));
+	}
+	// Keeps the particles with go[p] == 0, in their order.
+	static void keep(Particles<D>& P, const std::vector<uint8_t>& go)
+	{
+		size_t k = 0;
+		auto   compact = [&](auto& f) {
+			k = 0;
+			for (size_t p = 0; p < P.n; ++p)
+				if (!go[p]) f[k++] = f[p];
+			f.resize(k);
+		};
+		P.forEachRealField(compact);
+		compact(P.id), compact(P.mat);
+		P.n = k;
+	}
+	static void unpack(Particles<D>& P, const std::vector<double>& buf, size_t count, size_t nf)
+	{
+		if (!count) return;
+		const size_t n0 = P.n;
+		P.n += count;
+		size_t i = 0; // field index, in pack's order
+		P.forEachRealField([&](std::vector<Real>& f) {
+			f.resize(P.n);
+			for (size_t j = 0; j < count; ++j) f[n0 + j] = buf[j * nf + i];
+			++i;
+		});
+		P.id.resize(P.n), P.mat.resize(P.n);
+		for (size_t j = 0; j < count; ++j) {
+			std::memcpy(&P.id[n0 + j], &buf[j * nf + i], sizeof(int64_t));
+			P.mat[n0 + j] = uint8_t(buf[j * nf + i + 1]);
+		}
+	}
+};
+
+} // namespace mpm
+#endif
