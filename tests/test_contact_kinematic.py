@@ -1,4 +1,4 @@
-"""The kinematic contact law (law="kinematic", pkg-mpm/KinematicContact.hpp): impulses at the contacting particles,
+"""The kinematic contact law (law="kinematic", pkg-mpm/contact/KinematicContact.hpp): impulses at the contacting particles,
 no penetration beyond closing an overlap in one step, Coulomb + cohesion as an impulse limit. Checked against the
 exact incline acceleration g(sin θ − μ cos θ), a cohesive capacity A·c that holds at 1.1× the drive and gives way at
 0.9×."""

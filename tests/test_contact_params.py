@@ -1,4 +1,4 @@
-"""Contact parameters declared once (pkg-mpm/ContactParams.hpp, issue 20): every Python-visible contact
+"""Contact parameters declared once (pkg-mpm/contact/ContactParams.hpp, issue 20): every Python-visible contact
 attribute documents its unit and range, the ends of each range are enforced, doc/reference/contact.md holds the
 generated table, RigidBodies.add and DemSpheres.add take the same keywords, a body registered without mu
 takes tan(frictionAngle) of its YADE FrictMat (incline against g(sin θ − μ cos θ)), and the bad inputs of

@@ -1,4 +1,4 @@
-"""The Courant number C: one declaration (pkg-mpm/SolverSettings.hpp) that the scripts' --courant reads,
+"""The Courant number C: one declaration (pkg-mpm/core/SolverSettings.hpp) that the scripts' --courant reads,
 and the measurements of the time-step study (yade_mpm_paper.fidelity.courant) on constructed files with known answers."""
 import os
 import subprocess

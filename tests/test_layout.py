@@ -116,7 +116,6 @@ def test_no_script_function_longer_than_80_lines():
     assert not long, "\n".join(long)
 
 
-@pytest.mark.skipif(not os.path.isdir(os.path.join(ROOT, "pkg-mpm", "contact")), reason="pkg-mpm/contact/ not laid out")
 def test_no_contact_header_includes_an_mpi_header():
     bad = []
     for path in glob.glob(os.path.join(ROOT, "pkg-mpm", "contact", "*")):

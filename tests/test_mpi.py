@@ -1,4 +1,4 @@
-"""MPI domain decomposition (pkg-mpm/Decomposition.hpp, doc/developer/scaling.md): the same scene on 2 MPI ranks
+"""MPI domain decomposition (pkg-mpm/mpi/Decomposition.hpp, doc/developer/scaling.md): the same scene on 2 MPI ranks
 (``mpirun -np 2 --oversubscribe``, the MPI core _core_mpi) and on 1 process (the serial core _core),
 200 steps, gives the same particle fields by particle id within 1e-12 relative (the shared nodes' sums are
 added in another order: last-bit differences only), for a 2D and a 3D elastic block whose initial

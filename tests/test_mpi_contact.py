@@ -1,4 +1,4 @@
-"""Rigid YADE bodies under MPI (pkg-mpm/ContactMpi.hpp, doc/developer/scaling.md "Rigid bodies"): every rank runs the
+"""Rigid YADE bodies under MPI (pkg-mpm/mpi/MpiExchange.hpp, doc/developer/scaling.md "Rigid bodies"): every rank runs the
 same YADE scene; the contact of each rank's nodes is reduced over the ranks in rank order before YADE
 integrates the bodies. A 2D elastic block falling at 5 m/s (particles cross the slab boundary) is pushed by a rigid top platen (only the upper rank touches it) and a right platen (both ranks),
 and holds a free rigid filler in a vertical slot across the slab boundary (its stick step, bodyResponse,

@@ -1,4 +1,4 @@
-"""Dynamic load balance under MPI (pkg-mpm/Decomposition.hpp `rebalance`, doc/developer/scaling.md): a 2D elastic
+"""Dynamic load balance under MPI (pkg-mpm/mpi/Decomposition.hpp `rebalance`, doc/developer/scaling.md): a 2D elastic
 block (`yade_mpm_paper.cases.drifting_block`) drifting at 35 m/s along the slab axis through a tall empty grid (about 20 cells in 100 steps) moves
 its particles out of the start slabs. With the default `mpiRebalance = 1.1` the slabs are cut again from the
 particle counts per block layer; with `inf` they are not and one rank ends up holding every particle

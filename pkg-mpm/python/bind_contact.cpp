@@ -1,4 +1,4 @@
-// Solver2D/3D: rigid parts, contact groups with their ContactParams (pkg-mpm/ContactParams.hpp) and surface
+// Solver2D/3D: rigid parts, contact groups with their ContactParams (pkg-mpm/contact/ContactParams.hpp) and surface
 // primitives for PTS contact (paper Sec. 2.3); the YADE adapters are py/yade_mpm/bodies.py and spheres.py.
 #include "binding_common.hpp"
 

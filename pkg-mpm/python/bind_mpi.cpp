@@ -1,5 +1,5 @@
 // MPI build only (module yade_mpm._core_mpi, -DMPM_MPI): start-up of MPI and what Python may ask about
-// the decomposition (pkg-mpm/Decomposition.hpp, doc/developer/scaling.md).
+// the decomposition (pkg-mpm/mpi/Decomposition.hpp, doc/developer/scaling.md).
 #include "binding_common.hpp"
 
 #ifdef MPM_MPI

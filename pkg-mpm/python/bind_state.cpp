@@ -89,7 +89,7 @@ struct StateWrap {
 		s.setResumeState(r, std::vector<uint32_t>(p, p + a.shape(0)));
 	}
 
-	// ---- material that left the grid (Solver.outside; pkg-mpm/Removal.hpp) ----
+	// ---- material that left the grid (Solver.outside; pkg-mpm/step/Removal.hpp) ----
 	template <class T>
 	static np::ndarray column(const std::vector<RemovedParticle<D>>& rs, T (*get)(const RemovedParticle<D>&))
 	{

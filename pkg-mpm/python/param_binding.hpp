@@ -1,4 +1,4 @@
-// Boost.Python side of the one-declaration parameter tables (pkg-mpm/ParamTable.hpp).
+// Boost.Python side of the one-declaration parameter tables (pkg-mpm/core/ParamTable.hpp).
 // For a struct S with MPM_PARAMS(...), exposeParams<S>(cls, aliases) adds to the class:
 //   - one property per parameter, docstring from the table (doc, symbol, unit, range, default, Eq.),
 //     setter that refuses a wrong type or an out-of-range value with a ValueError naming the

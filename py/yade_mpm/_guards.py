@@ -17,7 +17,7 @@ import warnings
 
 
 def _thread_cap():
-    return max(16, 4 * (os.cpu_count() or 1))      # = setThreads' range (py/bindings.cpp maxThreads)
+    return max(16, 4 * (os.cpu_count() or 1))      # = setThreads' range (pkg-mpm/python/bindings.cpp maxThreads)
 
 
 def cap_omp_threads(environ=os.environ):

@@ -1,5 +1,5 @@
 """Rigid YADE bodies in an MPM scene: the adapter between ``O.bodies``/``O.forces`` and the core's PTS
-contact (paper Sec. 2.3, Eqs. 23–26; the algorithm is in pkg-mpm/PtsContact.hpp, see doc/reference/contact.md).
+contact (paper Sec. 2.3, Eqs. 23–26; the algorithm is in pkg-mpm/contact/PtsContact.hpp, see doc/reference/contact.md).
 
     rb = ym.RigidBodies(solver)
     rb.add(platen_id, mu=0.0)                       # one contact group per call, its own μ, c, χ, d0
@@ -29,7 +29,7 @@ per metre of the plane-strain slice: its dynamics match the MPM side for any t. 
 
 Contact parameters: the keywords ``law``, ``mu``, ``cohesion``, ``chi``, ``d0`` of ``add`` (the same for
 ``DemSpheres.add``) make one ``ym.ContactParams``, whose parameters are declared once, with unit, range,
-default and equation, in pkg-mpm/ContactParams.hpp (``print(ym.materials.describe(ym.ContactParams))``;
+default and equation, in pkg-mpm/contact/ContactParams.hpp (``print(ym.materials.describe(ym.ContactParams))``;
 table in doc/reference/contact.md). Every keyword is checked before any work; NumPy scalars are numbers.
   mu        friction coefficient μ_con [-]. Not given: tan(frictionAngle) of the bodies' YADE ``FrictMat``
             (``b.material``; a clump: its members'), the friction a YADE user sets on the body; explicit

@@ -1,6 +1,6 @@
 """Materials, named and parametrised the way YADE names its materials (``FrictMat``, ``JCFpmMat``).
 
-Every parameter is declared once, in ``pkg-mpm/MaterialParams.hpp`` (name, type, default, unit,
+Every parameter is declared once, in ``pkg-mpm/material/MaterialParams.hpp`` (name, type, default, unit,
 range, doc, paper equation). The classes below are generated from that table in the C++ binding:
 
 - keyword constructors, e.g. ``DpGkMat(young=..., poisson=..., ...)``: unknown names raise

@@ -9,7 +9,7 @@ instead when
 - the process was started by Open MPI's ``mpirun`` with more than one rank (``OMPI_COMM_WORLD_SIZE`` > 1).
 
 Under ``srun`` (Slurm) set ``YADE_MPM_MPI=1``. Every rank runs the same script and builds the same scene;
-the first step keeps each rank's slab of particles (pkg-mpm/Decomposition.hpp).
+the first step keeps each rank's slab of particles (pkg-mpm/mpi/Decomposition.hpp).
 """
 import os
 

@@ -19,7 +19,7 @@ def make_solver(lo, hi, spacing, margin=2):
 
 
 def check_setting(name, value, option=None):
-    """Checks a solver setting (declared once in pkg-mpm/SolverSettings.hpp) before any solver exists,
+    """Checks a solver setting (declared once in pkg-mpm/core/SolverSettings.hpp) before any solver exists,
     e.g. a command-line option; the ValueError names `option` (default: the setting) with the declared
     unit and range. Returns the value."""
     probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
@@ -33,7 +33,7 @@ def check_setting(name, value, option=None):
 
 
 def setting_default(name):
-    """The declared default of a solver setting (pkg-mpm/SolverSettings.hpp), e.g. for a script option
+    """The declared default of a solver setting (pkg-mpm/core/SolverSettings.hpp), e.g. for a script option
     whose default is the solver's: read here, never repeated."""
     probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
     if name not in probe.settings():

@@ -1,5 +1,5 @@
 """DEM spheres and clumps of spheres touching MPM particles, two-way, through the same PTS contact law
-as the rigid bodies of ``bodies.py`` (paper Sec. 2.3, Eqs. 23–26; pkg-mpm/PtsContact.hpp):
+as the rigid bodies of ``bodies.py`` (paper Sec. 2.3, Eqs. 23–26; pkg-mpm/contact/PtsContact.hpp):
 
     sp = ym.DemSpheres(solver)
     sp.add("all", mu=0.3)                              # every free sphere and sphere clump in O.bodies

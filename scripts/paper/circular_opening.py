@@ -67,7 +67,7 @@ def parse_args(argv=None):
                         "that are ≤ a and divide L/2)")
     p.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all cores)")
     p.add_argument("--progress", type=float, default=10.0, help="wall seconds between progress lines")
-    ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
+    ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/core/SolverSettings.hpp)
     p.add_argument("--no-vtu", dest="vtu", action="store_false", help="skip the VTU particle file")
     p.add_argument("--vtu-every", type=float, default=0.0,
                    help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "

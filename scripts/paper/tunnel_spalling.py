@@ -46,7 +46,7 @@ def parse():
     ap.add_argument("--spacing", type=float, default=None, help=f"grid spacing l [m] (default {DEFAULT_SPACING})")
     ap.add_argument("--paper", action="store_true", help=f"the paper's grid, l = {PAPER_SPACING} m (83 k particles)")
     ap.add_argument("--end-time", type=float, default=cases.TUNNEL_END_TIME, help="loading time [s] (default 0.02)")
-    ym.scene.courant_option(ap)                     # default: the solver's C (pkg-mpm/SolverSettings.hpp)
+    ym.scene.courant_option(ap)                     # default: the solver's C (pkg-mpm/core/SolverSettings.hpp)
     ap.add_argument("--threads", type=int, default=None, help="OpenMP threads (default: all cores)")
     ap.add_argument("--vtu-every", type=float, default=4e-3, help="simulated seconds between VTU files, plus 8, 12, 20 ms (default 0.004)")
     ap.add_argument("--checkpoint-every", default="5min",

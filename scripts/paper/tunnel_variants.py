@@ -38,7 +38,7 @@ def parse():
     if a.rock not in ROCKS:
         ap.error(f"--rock {a.rock!r} must be one of {ROCKS}")
     try:
-        ContactParams(mu=a.filler_friction)            # the range is declared once (pkg-mpm/ContactParams.hpp)
+        ContactParams(mu=a.filler_friction)            # the range is declared once (pkg-mpm/contact/ContactParams.hpp)
     except ValueError as e:
         ap.error(f"--filler-friction: {e}")
     if not (0 < a.end_time <= cases.TUNNEL_END_TIME):

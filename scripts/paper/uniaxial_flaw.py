@@ -68,7 +68,7 @@ def parse(argv=None):
     p.add_argument("--runs", default=None, help="subset, e.g. intact,open,filled:0.4:0 (variant:mu_con:c_con_MPa)")
     p.add_argument("--vtu-every", type=float, default=1e-3, help="VTU period [s] (default %(default)s)")
     p.add_argument("--progress", type=float, default=30.0, help="wall seconds between progress lines")
-    ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/SolverSettings.hpp)
+    ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/core/SolverSettings.hpp)
     p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json (and a study's OUT/*/runs/*/run.json) "
                    "into the summary")
     p.add_argument("--filler-blocked-dofs", default="zXY", help="blockedDOFs of the filler (default %(default)s: free in the "
