@@ -66,12 +66,23 @@ FIELDS2 = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol"]
 FIELDS3 = ["x0", "x1", "x2", "v0", "v1", "v2", "sig0", "sig1", "sig2", "sig3", "sig4", "sig5", "vol"]
 
 
+def _mpi_expected():
+    """True when the build found MPI (CMake writes build/mpi_expected): then the MPI tests must run."""
+    path = os.path.join(ROOT, "build", "mpi_expected")
+    return os.path.exists(path) and open(path).read().strip() == "ON"
+
+
 def _mpi_available():
+    """None when the MPI tests can run, else why not. A build that found MPI but whose MPI module or launcher is
+    missing fails here (at collection) instead of skipping."""
+    reason = None
     if shutil.which("mpirun") is None:
-        return "mpirun is missing (Debian: apt-get install openmpi-bin libopenmpi-dev)"
-    if not glob.glob(os.path.join(ROOT, "py", "yade_mpm", "_core_mpi*.so")):
-        return "the MPI core py/yade_mpm/_core_mpi*.so is not built (libopenmpi-dev missing when cmake ran)"
-    return None
+        reason = "mpirun is missing (Debian: apt-get install openmpi-bin libopenmpi-dev)"
+    elif not glob.glob(os.path.join(ROOT, "py", "yade_mpm", "_core_mpi*.so")):
+        reason = "the MPI core py/yade_mpm/_core_mpi*.so is not built (libopenmpi-dev missing when cmake ran)"
+    if reason and _mpi_expected():
+        pytest.fail(f"setup found MPI (build/mpi_expected = ON) but {reason}", pytrace=False)
+    return reason
 
 
 pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
