@@ -1,4 +1,7 @@
-"""Small scene builders shared by the foundation tests."""
+"""Small scene builders shared by the foundation tests, and where the shipped scripts are."""
+import glob
+import os
+
 import numpy as np
 import yade_mpm as ym
 
@@ -33,20 +36,13 @@ def total_momentum(s, d=2):
     return np.array([np.sum(m * s.view(f"v{a}")) for a in range(d)])
 
 
-ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def script_path(name):
     """A shipped script by file name, wherever its purpose folder keeps it (scripts/paper, scripts/studies,
     scripts/tools, scripts/, examples/)."""
-    import glob
-    import os
     found = sorted(glob.glob(os.path.join(ROOT, "scripts", "**", name), recursive=True) + glob.glob(os.path.join(ROOT, "examples", name)))
     assert len(found) == 1, f"script {name!r}: {found}"
     return found[0]
 
-
-def pythonpath():
-    """PYTHONPATH for a child process that must import this checkout's packages."""
-    import os
-    return os.pathsep.join([os.path.join(ROOT, "py")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])

@@ -1,4 +1,4 @@
-"""The project's layout, checked from the files (doc/developer/layout.md): two houses (the user package
+"""The project's layout, checked from the files (doc/developer/testing.md, doc/reference/architecture.md): two houses (the user package
 `yade_mpm`, the paper's reproduction `yade_mpm_paper`), no import circle, a small public namespace listed in the
 guide, docs without issue numbers or commit hashes in the guide and reference, short source files."""
 import ast
@@ -98,7 +98,7 @@ def test_guide_and_reference_name_no_issue_or_commit_and_no_doc_is_named_after_a
 
 def _sources():
     for pattern in ("py/**/*.py", "scripts/**/*.py", "examples/**/*.py", "tests/**/*.py", "pkg-mpm/**/*.hpp",
-                    "pkg-mpm/**/*.cpp", "py/**/*.cpp", "tests/cpp/*.cpp", "tests/cpp/*.hpp"):
+                    "pkg-mpm/**/*.cpp", "tests/cpp/*.cpp", "tests/cpp/*.hpp"):
         yield from glob.glob(os.path.join(ROOT, pattern), recursive=True)
 
 

@@ -85,7 +85,9 @@ def _mpi_available():
     return reason
 
 
-pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+MPI_MISSING = _mpi_available()          # once per session: every MPI test file takes its mark from here
+needs_mpi = pytest.mark.skipif(MPI_MISSING is not None, reason=str(MPI_MISSING))
+pytestmark = needs_mpi
 
 
 def _run(tmp_path, tag, dim, steps, ranks):

@@ -11,9 +11,9 @@ import sys
 import numpy as np
 import pytest
 
-from test_mpi import LAUNCH, ROOT, _mpi_available
+from test_mpi import LAUNCH, ROOT, needs_mpi
 
-pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+pytestmark = needs_mpi
 
 CHILD = r"""
 import sys

@@ -9,9 +9,9 @@ added in another order), and both ranks' YADE scenes hold the same bits."""
 import numpy as np
 import pytest
 
-from test_mpi import _max_rel, _merge, _mpi_available, run_child
+from test_mpi import _max_rel, _merge, run_child, needs_mpi
 
-pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+pytestmark = needs_mpi
 pytest.importorskip("yade")
 
 CHILD = r"""

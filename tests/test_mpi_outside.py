@@ -5,9 +5,9 @@ because it is detached from the body (the cluster map of intact material is comb
 import numpy as np
 import pytest
 
-from test_mpi import _mpi_available, run_child
+from test_mpi import run_child, needs_mpi
 
-pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+pytestmark = needs_mpi
 
 CHILD = r"""
 import sys

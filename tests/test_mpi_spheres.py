@@ -12,9 +12,9 @@ are the same bits on every rank, and the same schedule as 1 process."""
 import numpy as np
 import pytest
 
-from test_mpi import _max_rel, _merge, _mpi_available, run_child
+from test_mpi import _max_rel, _merge, run_child, needs_mpi
 
-pytestmark = pytest.mark.skipif(_mpi_available() is not None, reason=str(_mpi_available()))
+pytestmark = needs_mpi
 pytest.importorskip("yade")
 
 CHILD = r"""
