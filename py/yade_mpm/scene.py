@@ -6,14 +6,23 @@ from .fields import SYM_NAMES, dim_of
 from .geometry import _corners, _integer, _number, fill_region
 
 
-def make_solver(lo, hi, spacing, margin=2):
+def make_solver(lo, hi, spacing, margin=2, shift=None):
     """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
-    on every side, with grid spacing l = spacing [m]."""
+    on every side, with grid spacing l = spacing [m].
+    shift: per axis, a fraction of a cell in [0, 1) by which the grid's nodes are moved towards −axis
+    (None: no shift): the same scene cut differently by the grid, to measure how much a result depends on
+    where the grid cuts it (one more cell is added on a shifted axis, so [lo, hi] stays covered). A boundary
+    plane must still lie on a node line or halfway between two (addBoundaryPlane says which shifts fit)."""
     lo, hi = _corners(lo, hi, "make_solver")
     spacing = _number(spacing, "spacing", "m", positive=True)
     margin = _integer(margin, "margin [cells]", 0)
-    cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin)
-    origin = lo - margin * spacing
+    frac = np.zeros(len(lo))
+    if shift is not None:
+        frac = np.array([_number(f, "shift", "cells") for f in np.atleast_1d(shift)], float)
+        if frac.shape != lo.shape or not np.all((frac >= 0) & (frac < 1)):
+            raise ValueError(f"shift = {shift!r}: expected {len(lo)} fractions of a cell, each in [0, 1)")
+    cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin) + (frac > 0)
+    origin = lo - (margin + frac) * spacing
     cls = _core.Solver2D if len(lo) == 2 else _core.Solver3D
     return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells))
 

@@ -27,7 +27,7 @@ import numpy as np
 
 import yade_mpm as ym
 from yade_mpm import analysis, output, rocks, runner
-from yade_mpm_paper import batch, cases
+from yade_mpm_paper import batch, cases, uncertainty
 from yade_mpm.checkpoint import resumable
 from yade_mpm_paper.cases import tunnel_results as results
 
@@ -56,6 +56,7 @@ def parse():
     ap.add_argument("--flaw-angle", type=float, default=cases.FLAW_ANGLE_DEG, help="flaw inclination about its toe [°] (default %(default)s)")
     ap.add_argument("--filler-mu", type=float, default=cases.FILLER_FRICTION, help="filler–rock friction μ_con of filled_flaw (default %(default)s)")
     ap.add_argument("--grout-young", type=float, default=rocks.CEMENT_GROUT["young"], help="grout E of grout_flaw [Pa] (default %(default)s)")
+    uncertainty.shift_option(ap)
     ap.add_argument("--no-pictures", dest="pictures", action="store_false", help="skip the PNG pictures (a study's many runs)")
     a = batch.parse_args(ap)                  # the command line, or a yade-batch / scripts/studies/sweep.py table line
     a.cases = [c.strip() for c in a.cases.split(",") if c.strip()]
@@ -65,12 +66,15 @@ def parse():
     if a.paper and a.spacing is not None:
         ap.error("--paper sets the spacing; do not also give --spacing")
     a.spacing = PAPER_SPACING if a.paper else (a.spacing or DEFAULT_SPACING)
-    if not (0 < a.spacing <= cases.TUNNEL_MAX_SPACING):
-        ap.error(f"--spacing = {a.spacing} m must be in (0, {cases.TUNNEL_MAX_SPACING}] (the 2 mm flaw must cut a full particle row)")
+    top = cases.TUNNEL_INTACT_MAX_SPACING if a.cases == ["intact"] else cases.TUNNEL_MAX_SPACING
+    if not (0 < a.spacing <= top):
+        ap.error(f"--spacing = {a.spacing} m must be in (0, {top}] " + ("(8 cells across the opening)" if a.cases == ["intact"] else
+                 "(the 2 mm flaw must cut a full particle row; the intact case alone allows up to 5 mm)"))
     if not (0 < a.end_time <= 0.1):
         ap.error(f"--end-time = {a.end_time} s must be in (0, 0.1]")
     try:
         a.courant = ym.scene.check_courant(a.courant)
+        a.grid_shift = uncertainty.parse_shift(a.grid_shift)
     except ValueError as e:
         ap.error(str(e))
     if a.threads is not None and a.threads < 1:
@@ -91,7 +95,7 @@ class CaseRun:
         self.case, self.args = case, args
         self.dir = os.path.join(args.out, case)
         self.solver, self.bodies = cases.arch_tunnel(case, args.spacing, filler_friction=args.filler_mu, flaw_angle=math.radians(args.flaw_angle),
-                                                     grout=rocks.cement_grout(young=args.grout_young))
+                                                     grout=rocks.cement_grout(young=args.grout_young), grid_shift=args.grid_shift)
         s = self.solver
         s.courant = args.courant
         self.flaw = self.bodies["flaw"]
@@ -102,7 +106,8 @@ class CaseRun:
         self.job = resumable.ResumableRun(s, self.dir, state=dict(first_crack=None, snapshots=[]), every_steps=args.ck_steps,
                                           every_minutes=args.ck_minutes, engine=self.bodies["engine"],
                                           meta={"case": case, "spacing": args.spacing, "courant": args.courant, "flaw_angle": args.flaw_angle,
-                                                "filler_mu": args.filler_mu, "grout_young": args.grout_young})
+                                                "filler_mu": args.filler_mu, "grout_young": args.grout_young,
+                                                "grid_shift": args.grid_shift})
         self.failed, self.interrupted = None, False
 
     state = property(lambda self: self.job.state)             # the record: checkpointed, state.json at the end

@@ -28,7 +28,7 @@ import numpy as np
 
 import yade_mpm as ym
 from yade_mpm import analysis, output, runner
-from yade_mpm_paper import batch, cases, fidelity
+from yade_mpm_paper import batch, cases, fidelity, uncertainty
 from yade_mpm_paper.cases import uniaxial_results as results
 from yade_mpm_paper.cases.uniaxial_results import find_run as _find, read_curve as _curve, read_snapshot as _snap
 
@@ -71,6 +71,7 @@ def parse(argv=None):
     ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/core/SolverSettings.hpp)
     p.add_argument("--summary-only", action="store_true", help="only collect OUT/runs/*/run.json (and a study's OUT/*/runs/*/run.json) "
                    "into the summary")
+    uncertainty.shift_option(p)
     p.add_argument("--filler-blocked-dofs", default="zXY", help="blockedDOFs of the filler (default %(default)s: free in the "
                    "plane; zXYZ: no rotation)")
     a = batch.parse_args(p, argv)     # the command line, or a yade-batch / scripts/studies/sweep.py table line
@@ -82,6 +83,7 @@ def parse(argv=None):
     a.run_list = parse_runs(a.runs) if a.runs else all_runs()
     try:
         a.courant = ym.scene.check_courant(a.courant)
+        a.grid_shift = uncertainty.parse_shift(a.grid_shift)
     except ValueError as e:
         p.error(str(e))
     return a
@@ -94,7 +96,7 @@ def one_run(variant, mu, c_mpa, a):
     d = os.path.join(a.out, "runs", name)
     os.makedirs(d, exist_ok=True)
     s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
-                                filler_blocked=a.filler_blocked_dofs)
+                                filler_blocked=a.filler_blocked_dofs, grid_shift=a.grid_shift)
     s.courant = a.courant
     snaps = {}
     snapshot = results.field_snapshots(snaps, ("pos", "damage", "plastic_strain", "max_principal_stress"))
@@ -114,7 +116,7 @@ def one_run(variant, mu, c_mpa, a):
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=r["result"].reason,
                  error=getattr(r["result"], "error", None), time_reached_s=float(t[-1]),
-                 softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, courant=a.courant,
+                 softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, courant=a.courant, grid_shift=a.grid_shift,
                  filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],

@@ -27,7 +27,7 @@ from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_S
                       yade_platen)
 from .tunnel import (BAND_GAP, FILLER_FRICTION, FLAW_ANGLE, FLAW_ANGLE_DEG, FLAW_LENGTH, FLAW_TOE, FLAW_TOE_GAP, FLAW_TOE_HEIGHT,
                      FLAW_WIDTH, TUNNEL_CASES,
-                     TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
+                     TUNNEL_END_TIME, TUNNEL_FLOOR, TUNNEL_INTACT_MAX_SPACING, TUNNEL_MAX_SPACING, TUNNEL_RADIUS, TUNNEL_RECT, TUNNEL_WIDTH,
                      arch_tunnel, arch_tunnel_holes, arch_tunnel_specimen, tunnel_fidelity, tunnel_flaw, tunnel_flaw_at, tunnel_location,
                      tunnel_opening_distance, tunnel_report, tunnel_where)
 from .uniaxial import (UNIAXIAL_FLAW, UNIAXIAL_HEIGHT, UNIAXIAL_PAPER_SPACING, UNIAXIAL_SIDE_ROOM, UNIAXIAL_SLAB_CELLS, UNIAXIAL_VARIANTS,

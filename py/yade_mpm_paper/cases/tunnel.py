@@ -26,12 +26,14 @@ def arch_tunnel_holes(width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, rect=TUNNEL_RECT, 
 
 
 def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floor=TUNNEL_FLOOR, walls=("left", "right", "bottom"),
-                         holes=()):
+                         holes=(), grid_shift=None):
     """The tunnel specimen [0, width]² with the arch opening (and further `holes`), free-slip walls on
     `walls` (the paper's four sides minus the loaded top, where the caller puts a platen or a traction).
     material: default ``rocks.pan2020_sandstone()``. The opening must lie inside the specimen with at
     least one cell of rock around it: width ≥ 40 mm + 2·spacing, floor ≥ spacing and
-    floor + 45 mm (rectangle and roof) ≤ width − spacing. Returns the solver."""
+    floor + 45 mm (rectangle and roof) ≤ width − spacing. grid_shift: (fx, fy) fractions of a cell by which the
+    grid is moved against the specimen (``make_solver``'s shift), each 0 or 0.5 so that the slip walls stay on node
+    or half-node lines (None: none). Returns the solver."""
     spacing = _number(spacing, "spacing", "m", positive=True)
     width, floor = _number(width, "width", "m", positive=True), _number(floor, "floor", "m")
     if width < TUNNEL_RECT[0] + 2 * spacing:
@@ -46,7 +48,7 @@ def arch_tunnel_specimen(spacing, material=None, ppc=2, width=TUNNEL_WIDTH, floo
     if bad:
         raise ValueError(f"walls: unknown {bad}; allowed {sorted(planes)}")
     mat = material or rocks.pan2020_sandstone()
-    s = make_solver((0, 0), (width, width), spacing, margin=2)
+    s = make_solver((0, 0), (width, width), spacing, margin=2, shift=grid_shift)
     add_region(s, mat, (0, 0), (width, width), ppc=ppc, holes=list(arch_tunnel_holes(width, floor)) + list(holes))
     for w in walls:
         axis, side, pos = planes[w]
@@ -71,6 +73,7 @@ TUNNEL_END_TIME = 0.02             # loading time [s] (2 mm of platen displaceme
 FILLER_FRICTION = 0.6              # filler–rock μ_con [-] (the paper's rigid-filled case of Sec. 3.3, Figs. 14–15)
 TUNNEL_CASES = ("intact", "open_flaw", "filled_flaw", "grout_flaw")
 TUNNEL_MAX_SPACING = 1.25 * FLAW_WIDTH   # coarsest grid [m]: the flaw still cuts a full row of particles (ppc = 2)
+TUNNEL_INTACT_MAX_SPACING = 0.005        # coarsest grid of the intact case [m]: 8 cells across the 40 mm opening
 
 
 
@@ -108,7 +111,8 @@ def tunnel_flaw_at(floor=TUNNEL_FLOOR, angle=FLAW_ANGLE, toe_gap=FLAW_TOE_GAP, t
 
 def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PLATEN_SPEED,
                 platen_friction=PLATEN_FRICTION, filler_friction=FILLER_FRICTION, flaw_angle=FLAW_ANGLE, label="mpm",
-                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP, flaw_toe_height=FLAW_TOE_HEIGHT, contact_law=None):
+                floor=TUNNEL_FLOOR, flaw_toe_gap=FLAW_TOE_GAP, flaw_toe_height=FLAW_TOE_HEIGHT, contact_law=None,
+                grid_shift=None):
     """The scene of paper Sec. 4 in a fresh YADE scene (O.reset()): the 150 × 150 mm specimen with the
     arch tunnel, free-slip left, right and bottom walls, a rigid top platen (a YADE Box with blocked
     DOFs moving down at `platen_speed` [m/s], PTS contact with μ = platen_friction) and
@@ -123,6 +127,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     opening has 52.5 mm); flaw_toe_gap, flaw_toe_height [m]: the toe's distance from the left wall and height above
     the floor (``tunnel_flaw_at``; neither is given in the paper).
     contact_law: the platen and filler contact law, "kinematic" or "penalty" (None: the declared default).
+    grid_shift: the grid moved against the specimen by (fx, fy) cells, each 0 or 0.5 (``arch_tunnel_specimen``).
     O.engines = [ForceResetter, the MpmEngine (labelled `label`, with the bodies), NewtonIntegrator].
     Returns (solver, bodies): bodies = dict(platen=YADE id, filler=YADE id or None, rigid=RigidBodies,
     engine=MpmEngine, flaw=tunnel_flaw() or None, width=specimen width [m],
@@ -131,9 +136,10 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     if case not in TUNNEL_CASES:
         raise ValueError(f"case = {case!r} must be one of {TUNNEL_CASES}")
     spacing = _number(spacing, "spacing", "m", positive=True)
-    if not spacing <= TUNNEL_MAX_SPACING:
-        raise ValueError(f"spacing = {spacing!r} m must be in (0, {TUNNEL_MAX_SPACING}] m (the {FLAW_WIDTH * 1e3:g} mm flaw must "
-                         "cut at least one full particle row, particle spacing l/2)")
+    top = TUNNEL_INTACT_MAX_SPACING if case == "intact" else TUNNEL_MAX_SPACING
+    if not spacing <= top:
+        raise ValueError(f"spacing = {spacing!r} m must be in (0, {top}] m " + ("(8 cells across the 40 mm opening)" if case == "intact" else
+                         f"(the {FLAW_WIDTH * 1e3:g} mm flaw must cut at least one full particle row, particle spacing l/2)"))
     platen_speed = _number(platen_speed, "platen_speed", "m/s", positive=True)
     flaw_angle = _number(flaw_angle, "flaw_angle", "rad")
     if case != "intact" and not _flaw_clear(flaw_angle, spacing):
@@ -148,7 +154,7 @@ def arch_tunnel(case, spacing, material=None, grout=None, ppc=2, platen_speed=PL
     flaw = tunnel_flaw_at(floor, flaw_angle, flaw_toe_gap, flaw_toe_height) if case != "intact" else None
     rock = material or rocks.pan2020_sandstone()
     holes = [flaw["polygon"]] if flaw is not None else []
-    s = arch_tunnel_specimen(spacing, rock, ppc, floor=floor, holes=holes)
+    s = arch_tunnel_specimen(spacing, rock, ppc, floor=floor, holes=holes, grid_shift=grid_shift)
     if case == "grout_flaw":
         add_region(s, grout or rocks.cement_grout(), (0, 0), (W, W), ppc=ppc, keep=flaw["polygon"].contains)
     O.reset()

@@ -49,7 +49,7 @@ def exclude_nodes_inside(solver, polygon):
 def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None, platen_speed=PLATEN_SPEED,
                   platen_friction=PLATEN_FRICTION, label="mpm", with_bodies=True, filler_blocked="zXY",
                   ramp_time=0.0, end_cap_cells=0, side_room=UNIAXIAL_SIDE_ROOM, slab_cells=0,
-                  platen_d0=None, contact_law=None):
+                  platen_d0=None, contact_law=None, grid_shift=None):
     """The scene of paper Sec. 3.3 in a fresh YADE scene (O.reset()): a 50 × 150 mm specimen of
     ``rocks.miao2018_sandstone()`` (or `material`) on a free-slip base (y = 0), loaded by a rigid top
     platen (a YADE Box, blockedDOFs 'xyzXYZ', moving down at `platen_speed` [m/s], frictionless: the
@@ -78,6 +78,8 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     and the 2D run identical to roundoff, doc/validation/three_d.md).
     contact_law: the law of the platen and filler contacts, "kinematic" or "penalty" (None: the declared default;
     doc/reference/contact.md).
+    grid_shift: (fx, fy) fractions of a cell by which the grid is moved against the specimen (``make_solver``'s
+    shift; None: none): fy must be 0 or 0.5 (the slip base stays on a node or half-node line).
     spacing: grid spacing l [m] (paper 0.5 mm); ppc particles per cell per axis. with_bodies=False builds
     the same particles with no YADE bodies at all (the benchmark's reference for the contact cost).
     Returns (solver, scene) with scene = dict(platen, filler (YADE ids; filler None unless filled),
@@ -111,7 +113,7 @@ def uniaxial_flaw(variant, spacing, mu_con=0.0, c_con=0.0, ppc=2, material=None,
     rock = material or rocks.miao2018_sandstone()
     side = side_room                               # grid room beside the free faces for spalled fragments
     zt = (T,) if slab_cells else ()
-    s = make_solver((-side, 0) + z, (W + side, H + side) + zt, spacing, margin=2)   # room above too: fragments rise beside the platen
+    s = make_solver((-side, 0) + z, (W + side, H + side) + zt, spacing, margin=2, shift=grid_shift)   # room above too: fragments rise beside the platen
     add_region(s, rock, (0, 0) + z, (W, H) + zt, ppc=ppc, holes=[flaw["polygon"]] if flaw is not None else [])
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     if slab_cells:                                 # front and back faces: slip (symmetry) planes

@@ -204,7 +204,7 @@ PAPER_UNIAXIAL = ("not run: at 0.5 mm the open-flaw scene has 119,200 particles 
 PAPER_UNIAXIAL_SUBSET = ("not run at 0.5 mm: a run this row needs is not among the paper-grid runs (their list: the section "
                          "'Uniaxial compression with a flaw at the paper's grid' below)")
 PAPER_TUNNEL = ("not run at l = 1 mm with this build; the last 1 mm runs (an earlier build, ε̄p grown by the von Mises "
-                "Δλ/√3 before issue 18) are in archive/paper_grid_and_courant_7ac11e5.md")
+                "Δλ/√3, the earlier default) are in archive/paper_grid_and_courant_7ac11e5.md")
 PAPER_BENCH = "not run at the paper's grid"
 # the paper's grid spacing [m] of the benchmarks (Sec. 3.1: 0.01 m, 998,696 particles; Sec. 3.2: 0.02 m, 249,840 particles),
 # the summary key of a run's spacing, and the part that holds a separate run at the paper's grid

@@ -9,14 +9,16 @@ from .document import REPO, frozen, include_notes, shown
 
 
 # ---------------------------------------------------------------------------------- fidelity (issue 18)
-def load_tunnel(R, part):
+def load_tunnel(R, part, folder=None):
     """A tunnel folder's summary cases and each case's case.json, or None (nothing written)."""
-    s = R.read(part)
-    if s is None:
+    folder = folder or R.folder(part)
+    path = os.path.join(folder, "summary.json")
+    if not os.path.exists(path):
         return None
+    s = json.load(open(path))
     info = {}
     for e in s["cases"]:
-        cj = os.path.join(R.folder(part), e["case"], "case.json")
+        cj = os.path.join(folder, e["case"], "case.json")
         info[e["case"]] = json.load(open(cj)) if os.path.exists(cj) else None
     return dict(cases=s["cases"], info=info)
 
@@ -29,11 +31,17 @@ def fidelity_section(R):
     parts["penny_crack_damage"] = parts["penny_crack_damage"] or parts["penny_crack"]   # one run with --parts elastic,damage
     parts.update(tunnel=load_tunnel(R, "tunnel"), tunnel_paper=load_tunnel(R, "tunnel_paper"))
     rows = fidelity_table.rows(parts)
+    spread = ensemble_rows(R, rows, parts)
     R.w("## Fidelity table: the paper's claims about its results, measured", "",
         "One row per claim of the paper (figure numbers are the paper's). *Measured* is computed from the fields of the runs "
         "below (`yade_mpm_paper.fidelity`, `yade_mpm_paper.fidelity.table`, `yade_mpm.analysis`), not read off a picture. Default grid: "
         "tunnel and uniaxial 2 mm; paper grid: tunnel 1 mm, uniaxial 0.5 mm. Verdicts: agrees / partly / differs / not run / "
         "no reference (the paper gives no number).", "")
+    if spread:
+        R.w("**Uncertainty.** " + "; ".join(spread) + " (section *Spread over where the grid cuts the specimen*). In the default-grid "
+            "column a number that differs between those runs reads `v [min–max]` (v: the unshifted run). The verdict rule: a verdict "
+            "(agrees, partly, differs) stands when every run of the ensemble gives it; when they disagree the row reads *within "
+            "uncertainty* with the count of each verdict.", "")
     include_notes(R, os.path.join(R.root, "fidelity_notes.md"))
     R.w("| figure | the paper's claim | measured, default grid | verdict | measured, paper grid | verdict |", "|---|---|---|---|---|---|")
     for r in rows:
@@ -51,6 +59,30 @@ def fidelity_section(R):
     include_notes(R, os.path.join(R.root, "fidelity_grids.md"))
 
 
+def ensemble_rows(R, rows, parts):
+    """Every default-grid row of a scene with a grid-shift ensemble: its text over the ensemble's runs (numbers with
+    their range) and the combined verdict (yade_mpm_paper.uncertainty). Returns what was merged, as sentences."""
+    from yade_mpm_paper import uncertainty
+    from yade_mpm_paper.fidelity import table as fidelity_table
+    from .uncertainty_sections import members
+    said = []
+    for scene, part in (("uniaxial", "uniaxial_flaw"), ("tunnel", "tunnel")):
+        ms = members(R, scene)
+        if len(ms) < 2:
+            continue
+        per = []
+        for _, f in ms:
+            p = dict(parts)
+            p[part] = load_tunnel(R, part, f) if scene == "tunnel" else json.load(open(os.path.join(f, "summary.json")))
+            per.append(fidelity_table.rows(p))
+        for i, r in enumerate(rows):
+            if r["part"] == part:
+                r["default"] = uncertainty.merge_texts([pr[i]["default"] for pr in per])
+                r["verdict"] = uncertainty.combined_verdict([pr[i]["verdict"] for pr in per])
+        said.append(f"{scene} rows over {len(ms)} runs of the default grid, shifted by {', '.join(m for m, _ in ms)}")
+    return said
+
+
 OLD_INCREMENT = "fidelity_variants_b86bf5e.md"    # the variant matrix run with Δε̄p = Δλ/√3 (before issue 18's default), kept verbatim
 
 
@@ -61,7 +93,7 @@ def variant_matrix(R, folder="fidelity_variants"):
     if not files:
         R.w(f"*Not run here* — `/usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial|tunnel ...` writes `{shown(os.path.join(R.root, folder))}/`.", "")
         if os.path.exists(os.path.join(REPO, "archive", "fidelity_variants_d734961.md")):
-            R.w("The last screening matrix (build before issue 17's contact fix, C = 0.5) is kept verbatim in "
+            R.w("The last screening matrix (a build before the contact fix that made it independent of where the grid cuts a body, C = 0.5) is kept verbatim in "
                 "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md); its Δt rows are superseded by the time-step study below.", "")
         return
     runs = [json.load(open(f)) for f in files]
@@ -69,7 +101,7 @@ def variant_matrix(R, folder="fidelity_variants"):
         done = {(r["scene"], r["variant"]) for r in runs}
         old = [n for v, n in (("as_printed_growth", "uniaxial growth law"), ("v_cube", "V = dp³"), ("no_residual_cohesion", "residual cohesion"),
                               ("soft_strain_0.01", "ε̄p,crit = 0.01")) if ("uniaxial", v) not in done] + ["tunnel intact at 2.5 mm"]
-        R.w(f"Variants not in the matrix below ({', '.join(old)}) were screened on an older build (before issue 17's contact fix): "
+        R.w(f"Variants not in the matrix below ({', '.join(old)}) were screened on an older build (before the contact fix that made it independent of where the grid cuts a body): "
             "[fidelity_variants_d734961.md](../../archive/fidelity_variants_d734961.md), kept verbatim.", "")
     if os.path.exists(os.path.join(REPO, "archive", OLD_INCREMENT)):
         done = {r["variant"] for r in runs if r["scene"] == "tunnel"}
@@ -132,7 +164,7 @@ def courant_section(R, folder="courant"):
     from yade_mpm_paper.fidelity import courant as fidelity_courant
     d = os.path.join(R.root, folder)
     runs = {float(os.path.basename(f)[1:]): f for f in sorted(glob.glob(os.path.join(d, "c*"))) if os.path.isdir(f)}
-    R.w("## Time step: the Courant number chosen by accuracy (issue 19)", "")
+    R.w("## Time step: the Courant number chosen by accuracy", "")
     if not runs:
         R.w(f"*Not run here* — the scripts of `scripts/regress.py` with `--courant C` into `{shown(d)}/cC/` (see the notes of a run).", "")
         frozen(R)

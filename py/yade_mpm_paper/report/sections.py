@@ -1,5 +1,4 @@
-"""The validation report's sections of the reproduced cases (scripts/paper/report.py): error against run
-time of the benchmarks, the circular opening (Kirsch), the line crack (Sneddon, Fig. 9), the stability
+"""The validation report's sections of the reproduced cases (scripts/paper/report.py): the circular opening (Kirsch), the line crack (Sneddon, Fig. 9), the stability
 suite, the uniaxial flaw runs and the arch tunnel with the README's picture."""
 import glob
 import json
@@ -11,43 +10,6 @@ from .document import fmt, frozen, include_notes, shown, table
 
 
 # ------------------------------------------------------------------------------------- benchmarks
-def error_vs_time(R, circ, penny):
-    series = []
-    if circ and circ.get("convergence"):
-        c = circ["convergence"]
-        series.append(("circular opening: max L2 rel. error of σ vs Kirsch", [r["wall_time_s"] for r in c],
-                       [r["l2_rel_error_max"] for r in c], [r["grid_spacing_m"] for r in c]))
-    if penny and penny.get("convergence"):
-        c = penny["convergence"]
-        series.append(("penny crack: L2 rel. error of the opening u_y vs Sneddon", [r["wall_time_s"] for r in c],
-                       [r["uy_l2_rel_error"] for r in c], [r["spacing_m"] for r in c]))
-    R.w("## Error against run time (benchmarks)", "")
-    if not series:
-        R.w("No convergence runs found (`--convergence` of circular_opening.py, the convergence part of penny_crack.py).", "")
-        return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    for (label, t, e, l), m in zip(series, ("o-", "s-")):
-        ax.loglog(t, e, m, label=label)
-        for ti, ei, li in zip(t, e, l):
-            ax.annotate(f"l = {li:g} m", (ti, ei), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    ax.set_xlabel("wall time of the run [s]")
-    ax.set_ylabel("relative error")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    p = os.path.join(R.fig_dir, "error_vs_walltime.png")
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
-    R.w(f"![error against wall time]({os.path.relpath(p, R.doc)})", "")
-    for label, t, e, l in series:
-        R.w(f"**{label}**", "")
-        R.w(*table([dict(l=a, t=b, e=c) for a, b, c in zip(l, t, e)],
-                   [("grid spacing [m]", lambda r: r["l"]), ("wall time [s]", lambda r: r["t"]), ("relative error", lambda r: r["e"])]))
-
-
 def circular(R):
     R.w("## Circular opening (paper Sec. 3.1, Kirsch)", "")
     s = R.load("circular_opening")
@@ -65,7 +27,8 @@ def penny(R):
     s = R.load("penny_crack")
     if s is not None:
         if s.get("convergence"):
-            R.w("Elastic opening against Sneddon (Eq. 43): see *Error against run time* above.", "")
+            R.w("Elastic opening against Sneddon (Eq. 43): the convergence of this run's own script below; across grids and time "
+                "steps: *Error against run time* above.", "")
         R.figures("penny_crack", ["error_vs_walltime.png"])
     dmg = R.read("penny_crack_damage") if "penny_crack_damage" in R.dirs else None
     s = dmg or s
@@ -93,7 +56,8 @@ def stability(R):
                                     ("expected", lambda r: r.get("expected_outcome")),
                                     ("max energy ratio", lambda r: r.get("max_energy_ratio")), ("steps", lambda r: r.get("steps")),
                                     ("NaN seen", lambda r: r.get("nan_seen")), ("wall [s]", lambda r: r.get("wall_time_s")),
-                                    ("passed", lambda r: r.get("passed"))]))
+                                    ("passed", lambda r: r.get("passed")),
+                                    ("what a stopped case printed", lambda r: (r.get("message") or "")[:200].replace("|", "/").replace("\n", " ") or None)]))
     rows = s.get("cases", [])
     bad = [r.get("case") for r in rows if not (r.get("passed") and r.get("outcome") == r.get("expected_outcome"))]
     R.w(f"All {len(rows)} cases passed (each with its expected outcome)." if rows and not bad else

@@ -1,0 +1,67 @@
+"""The numerical-uncertainty tools: the grid shift of make_solver (the same scene cut differently by the grid),
+observed orders and Richardson extrapolation, and how the fidelity table merges an ensemble's texts and verdicts."""
+import math
+
+import numpy as np
+import pytest
+
+import yade_mpm as ym
+from yade_mpm import rocks
+from yade_mpm_paper import uncertainty as U
+
+
+def test_shift_moves_the_grid_and_keeps_the_region_covered():
+    lo, hi, l = np.array([0.0, 0.0]), np.array([1.0, 0.5]), 0.1
+    s0 = ym.make_solver(lo, hi, l)
+    s1 = ym.make_solver(lo, hi, l, shift=(0.3, 0.5))
+    assert np.allclose(np.array(s1.origin), np.array(s0.origin) - np.array([0.3, 0.5]) * l, rtol=0, atol=1e-15)
+    for s in (s0, s1):
+        top = np.array(s.origin) + np.array(s.cells) * l
+        assert np.all(top >= hi + 2 * l - 1e-12) and np.all(np.array(s.origin) <= lo - 2 * l + 1e-12)
+    with pytest.raises(ValueError, match=r"shift = .*\[0, 1\)"):
+        ym.make_solver(lo, hi, l, shift=(1.0, 0.0))
+    with pytest.raises(ValueError, match="shift"):
+        ym.make_solver(lo, hi, l, shift=(0.1,))
+
+
+@pytest.mark.parametrize("shift", [None, (0.3, 0.7)])
+def test_a_translating_block_stays_rigid_at_any_shift(shift):
+    """The WLS shape functions reproduce a constant field wherever the grid cuts the block: a block moving at a
+    uniform velocity keeps it and stays stress-free, its particles displaced by v·t (to round-off)."""
+    s = ym.make_solver((0.0, 0.0), (0.6, 0.4), 0.05, shift=shift)
+    ym.add_region(s, rocks.granite(), (0.0, 0.0), (0.6, 0.4), ppc=2)
+    from yade_mpm.fields import views     # the power-user door: set the initial velocity in place
+    v = views(s)
+    v["v0"][:], v["v1"][:] = 3.0, -1.5
+    x0 = ym.get(s, "pos")
+    for _ in range(20):
+        s.step()
+    assert np.abs(ym.get(s, "vel") - [3.0, -1.5]).max() < 1e-9
+    assert np.abs(ym.get(s, "pos") - x0 - np.array([3.0, -1.5]) * s.time).max() < 1e-12
+    assert np.abs(ym.get(s, "stress")).max() < 1e-3                # Pa, against E·(v Δt / l) ~ 1e7 for a wrong field
+
+
+def test_observed_order_and_richardson():
+    h = [0.04, 0.02, 0.01]
+    assert U.observed_order(h, [0.4, 0.1, 0.025]) == pytest.approx([2.0, 2.0])
+    q = [1.0 + 3.0 * x ** 1.5 for x in h]                        # q(h) = q∞ + c h^p, p = 1.5
+    r = U.richardson(h, q)
+    assert r["monotone"] and r["order"] == pytest.approx(1.5) and r["limit"] == pytest.approx(1.0, rel=1e-12)
+    assert U.richardson(h, [1.0, 1.2, 1.1])["limit"] is None     # not monotone: no extrapolation
+    with pytest.raises(ValueError, match="constant ratio"):
+        U.richardson([0.04, 0.02, 0.015], q)
+
+
+def test_spread_and_merge_and_verdict_rule():
+    sp = U.spread([1.0, 2.0, 3.0, None, math.nan])
+    assert sp["n"] == 3 and sp["mean"] == 2.0 and sp["min"] == 1.0 and sp["cv"] == pytest.approx(np.std([1, 2, 3]) / 2)
+    assert U.spread([None]) is None
+    t = U.merge_texts(["peak 28.0 MPa at μ_con = 0.6", "peak 29.5 MPa at μ_con = 0.6", "peak 27.0 MPa at μ_con = 0.6"])
+    assert t == "peak 28.0 [27–29.5] MPa at μ_con = 0.6"
+    assert "differ in 1 of the 1" in U.merge_texts(["at 1.0 ms", "never"])
+    assert U.combined_verdict(["agrees", "agrees"]) == "agrees"
+    assert U.combined_verdict(["agrees", "differs", "agrees"]) == "within uncertainty (agrees 2, differs 1 of 3)"
+    assert U.parse_shift("0.2,0.5") == (0.2, 0.5) and U.parse_shift("0,0") is None and U.parse_shift(None) is None
+    for bad in ("1,0", "0.2", "a,b"):
+        with pytest.raises(ValueError, match="--grid-shift"):
+            U.parse_shift(bad)
