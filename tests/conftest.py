@@ -11,7 +11,7 @@ import pytest  # noqa: E402
 TOPICS = {
     "unit": ["test_analysis", "test_bad_input", "test_entrance_errors", "test_fields", "test_layout", "test_params",
              "test_rocks", "test_runner", "test_shape_functions", "test_contact_params", "test_hazards", "test_bench_kernel",
-             "test_uncertainty"],
+             "test_uncertainty", "test_threads"],
     "physics": ["test_boundaries", "test_contact", "test_contact_yade", "test_contact_corners", "test_contact_initial_d0",
                 "test_contact_kinematic", "test_contact_matrix", "test_contact_stick", "test_courant", "test_damage_threshold",
                 "test_determinism", "test_dpgk", "test_dpgk_damage", "test_elastic_dynamics", "test_multimaterial", "test_outside",

@@ -15,8 +15,9 @@ from . import _guards
 _guards.cap_omp_threads()   # before libgomp reads OMP_NUM_THREADS (loaded with _core)
 from . import parallel
 _core = parallel.load_core(__name__)   # the serial core, or under mpirun the MPI build (doc/developer/scaling.md)
-from ._core import Solver2D, Solver3D, MpmSimulationError, setThreads, getThreads, ContactParams
+from ._core import Solver2D, Solver3D, MpmSimulationError, getThreads, ContactParams
 from . import _core
+from .threads import setThreads   # the user's count; otherwise the faster of all / half the cores (yade_mpm.threads)
 _guards.install(_core)      # Solver.view("id") read-only, Solver.reserve(n) checked against the memory
 _guards.cap_core_threads(_core)
 from .materials import ElasticMat, DpGkMat

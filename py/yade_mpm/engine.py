@@ -12,7 +12,10 @@ O.time and O.iter stay the simulation's clock. The PyRunner carries the label, a
 With rigid bodies (``bodies``, a ``yade_mpm.RigidBodies``), each step reads their kinematics from
 O.bodies before the MPM step and adds the contact reactions to O.forces after it, so the PyRunner must
 come after ForceResetter and before NewtonIntegrator."""
+import time as _time
+
 from .progress import Progress
+from .threads import governor
 
 _registry = {}
 
@@ -85,7 +88,11 @@ class MpmEngine:
             self.last_set_dt = O.dt
             for b in self._adapters:
                 b.read()
+            t = _time.perf_counter()
             s.advance(O.dt)
+            gov = governor()
+            if gov is not None:
+                gov.tick(_time.perf_counter() - t)   # on a shared host the faster thread count (yade_mpm.threads)
             for b in self._adapters:
                 b.write()
         except Exception as e:  # stop YADE cleanly with the message instead of stepping on

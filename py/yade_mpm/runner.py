@@ -198,7 +198,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         raise ValueError(f"on_error = {on_error!r} must be 'raise' or 'return'")
     if advance is not None and not callable(advance):
         raise ValueError(f"advance = {advance!r} must be callable as f() (one step of the simulation)")
-    step = advance if advance is not None else solver.step
+    step = advance if advance is not None else _governed(solver.step)   # through YADE the MpmEngine reports the steps
     outs = _outputs(every, outputs)
     if progress is None or progress is False:
         prog = None
@@ -251,6 +251,21 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         return RunResult("error", taken, solver.time, _time.time() - wall0, error=str(e))
     _finish(solver, outs, prog)
     return RunResult(reason, taken, solver.time, _time.time() - wall0)
+
+
+def _governed(step):
+    """step(), its wall time reported to the thread governor (yade_mpm.threads) when one is active."""
+    from .threads import governor
+    if governor() is None:
+        return step
+
+    def timed():
+        t = _time.perf_counter()
+        step()
+        gov = governor()
+        if gov is not None:
+            gov.tick(_time.perf_counter() - t)
+    return timed
 
 
 def _finish(solver, outs, prog):
