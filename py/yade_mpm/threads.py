@@ -26,13 +26,13 @@ class Governor:
     """Keeps the faster of two thread counts, hi (all cores) and lo = hi // 2, measured in alternating windows.
 
     window [s]: wall time of one measuring window (at least `min_steps` steps); probe_every [s]: wall time between
-    probes of the other count; margin: the other count is kept only if it ran faster by more than this fraction."""
+    probes of the other count (the first after `first_probe` s); margin: the other count is kept only if it ran faster by more than this fraction."""
 
-    def __init__(self, hi=None, window=0.5, min_steps=20, probe_every=30.0, margin=0.1, clock=time.perf_counter,
+    def __init__(self, hi=None, window=0.5, min_steps=20, probe_every=30.0, first_probe=2.0, margin=0.1, clock=time.perf_counter,
                  set_threads=None):
         self.hi = int(hi or available_cores())
         self.lo = max(1, self.hi // 2)
-        self.window, self.min_steps, self.probe_every, self.margin = window, min_steps, probe_every, margin
+        self.window, self.min_steps, self.probe_every, self.first_probe, self.margin = window, min_steps, probe_every, first_probe, margin
         self.clock, self.set_threads = clock, set_threads or _core.setThreads
         self.enabled = self.hi > 1
         self.current = self.hi
@@ -50,8 +50,8 @@ class Governor:
         if not self.enabled:
             return
         now = self.clock()
-        if self.last_probe is None:
-            self.last_probe = now
+        if self.last_probe is None:                          # the first probe comes early: a short run is helped too
+            self.last_probe = now - self.probe_every + self.first_probe
         self.steps += 1
         self.wall += step_wall
         if self.steps < self.min_steps or self.wall < self.window:
