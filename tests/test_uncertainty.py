@@ -65,3 +65,22 @@ def test_spread_and_merge_and_verdict_rule():
     for bad in ("1,0", "0.2", "a,b"):
         with pytest.raises(ValueError, match="--grid-shift"):
             U.parse_shift(bad)
+
+
+def test_convergence_paths_from_runs():
+    """scripts/paper/convergence.py: errors and orders along a refinement path, analytic and Richardson."""
+    import importlib.util
+    from helpers import script_path
+    spec = importlib.util.spec_from_file_location("convergence_script", script_path("convergence.py"))
+    conv = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conv)
+    rows = [dict(courant=1.0, spacing_m=l, error=0.1 * (l / 0.004) ** 2, peak_MPa=95.0 + 400.0 * l, particles=100, steps=10,
+                 particle_steps=1000, cpu_s=1.0 / l, wall_s=1.0 / l) for l in (0.004, 0.002, 0.001)]
+    paths = conv.paths("uniaxial_intact", rows)
+    modulus = [p for p in paths if p["key"] == "error" and p["courant"] == 1.0][0]
+    assert modulus["orders"] == pytest.approx([2.0, 2.0]) and modulus["reference_kind"] == "analytic"
+    peak = [p for p in paths if p["key"] == "peak_MPa" and p["courant"] == 1.0][0]
+    assert peak["richardson"]["order"] == pytest.approx(1.0) and peak["reference"] == pytest.approx(95.0)
+    assert peak["error"][-1] == pytest.approx(0.4 / 95.0)
+    assert [p for p in paths if p["courant"] == 0.5][0]["spacing_m"] == []     # no runs at C = 0.5: an empty path
+    assert "| uniaxial_intact |" in conv.table(dict(families={"uniaxial_intact": dict(paths=paths, failed=[])}))
