@@ -48,6 +48,7 @@ def test_observed_order_and_richardson():
     r = U.richardson(h, q)
     assert r["monotone"] and r["order"] == pytest.approx(1.5) and r["limit"] == pytest.approx(1.0, rel=1e-12)
     assert U.richardson(h, [1.0, 1.2, 1.1])["limit"] is None     # not monotone: no extrapolation
+    assert U.richardson(h, [53.05, 52.88, 52.54])["limit"] is None   # monotone but the changes grow: not converging
     with pytest.raises(ValueError, match="constant ratio"):
         U.richardson([0.04, 0.02, 0.015], q)
 

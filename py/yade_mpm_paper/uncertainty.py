@@ -69,7 +69,8 @@ def observed_order(h, e):
 
 def richardson(h, q):
     """Richardson extrapolation of the last three results of q(h) (h decreasing by a constant ratio r):
-    dict(order p, limit q∞, monotone) — p and q∞ None when the sequence is not monotone (no extrapolation then)."""
+    dict(order p, limit q∞, monotone) — p and q∞ None unless the sequence is monotone and converging (each
+    change smaller than the last; no extrapolation then)."""
     if len(q) < 3:
         return dict(order=None, limit=None, monotone=False)
     (h1, h2, h3), (q1, q2, q3) = h[-3:], q[-3:]
@@ -77,8 +78,8 @@ def richardson(h, q):
     if not (abs(h2 / h3 - r) < 1e-6 * r and r > 1):
         raise ValueError(f"richardson: spacings {h[-3:]} do not fall by a constant ratio")
     d1, d2 = q1 - q2, q2 - q3
-    if d1 == 0 or d2 == 0 or d1 * d2 < 0:
-        return dict(order=None, limit=None, monotone=False)
+    if d1 == 0 or d2 == 0 or d1 * d2 < 0 or abs(d2) >= abs(d1):
+        return dict(order=None, limit=None, monotone=d1 * d2 > 0)
     p = math.log(d1 / d2) / math.log(r)
     return dict(order=p, limit=q3 + (q3 - q2) / (r ** p - 1), monotone=True)
 

@@ -5,7 +5,8 @@ two Courant numbers, every run in its own one-thread process, with its wall time
     /usr/bin/python3 scripts/paper/convergence.py --out out/convergence --families kirsch,sneddon
 
 Families (yade_mpm_paper.uncertainty for the orders and the Richardson limit):
-    kirsch           circular opening, max L2 relative error of σxx, σyy on the x and y lines against Kirsch (Eqs. 41–42)
+    kirsch           circular opening (relaxed to a 1e-4 change): max L2 relative error of σxx, σyy on the x and y lines
+                     against Kirsch (Eqs. 41–42), the same within 5 radii, the hoop stress at the wall (θ = 90°)
     sneddon          pressurised line crack (crack nodes excluded), L2 relative error of the opening against Sneddon (Eq. 43)
     uniaxial_intact  intact specimen (DP–GK): apparent modulus against the plane-strain E/(1 − ν²); the peak against
                      its Richardson limit
@@ -35,7 +36,8 @@ from yade_mpm_paper import uncertainty  # noqa: E402
 QUIET = ["--progress", "600"]
 FAMILIES = {   # name: (spacings [m] coarse → fine, Courant numbers, command of one run)
     "kirsch": ((0.08, 0.04, 0.02), (0.5, 0.25),
-               lambda l, c, d: ["circular_opening.py", "--out", d, "--spacing", f"{l:g}", "--courant", f"{c:g}", "--no-convergence", "--no-vtu"]),
+               lambda l, c, d: ["circular_opening.py", "--out", d, "--spacing", f"{l:g}", "--courant", f"{c:g}", "--no-convergence", "--no-vtu",
+                                 "--tol", "1e-4"]),   # relaxed 10× further than the script's default: the discretisation error shows
     "sneddon": ((0.08, 0.04, 0.02), (0.5, 0.25),
                 lambda l, c, d: ["penny_crack.py", "--out", d, "--parts", "elastic", "--spacing", f"{l:g}", "--courant", f"{c:g}",
                                  "--crack-nodes", "excluded"]),
@@ -56,7 +58,7 @@ def quantities(family, d):
     """The run's numbers: dict(particles, steps, error or value quantities) from its summary.json."""
     s = json.load(open(os.path.join(d, "summary.json")))
     if family == "kirsch":
-        return dict(particles=s["particles"], steps=s["steps"], error=s["l2_rel_error_max"],
+        return dict(particles=s["particles"], steps=s["steps"], error=s["l2_rel_error_max"], near_error=s["l2_rel_error_near_max"],
                     hoop90_error=s["hoop_stress_theta90_MPa"] / s["kirsch_hoop_theta90_MPa"] - 1)
     if family == "sneddon":
         return dict(particles=s["elastic_particles"], steps=s["elastic_steps"], error=s["uy_l2_rel_error"], centre_error=s["uy_center_rel_error"])
@@ -73,7 +75,8 @@ def quantities(family, d):
 
 
 MEASURES = {   # family: (quantity, "analytic" = the quantity is the signed relative error | "richardson" = a value, its label)
-    "kirsch": (("error", "analytic", "max L2 rel. error of σ vs Kirsch"),),
+    "kirsch": (("error", "analytic", "max L2 rel. error of σ vs Kirsch, r ≥ 2a"), ("near_error", "analytic", "same, 2a ≤ r ≤ 5a"),
+               ("hoop90_error", "analytic", "hoop stress at the wall, θ = 90°")),
     "sneddon": (("error", "analytic", "L2 rel. error of the opening vs Sneddon"),),
     "uniaxial_intact": (("error", "analytic", "apparent modulus vs E/(1−ν²)"), ("peak_MPa", "richardson", "peak stress")),
     "tunnel_elastic": (("stress_0.5mm_MPa", "richardson", "σ at 0.5 mm of travel"),),
