@@ -45,7 +45,9 @@ def test_flaw_cut_filler_and_grout():
     with pytest.raises(ValueError, match="case"):
         cases.arch_tunnel("half_flaw", L)
     with pytest.raises(ValueError, match="spacing"):
-        cases.arch_tunnel("intact", 0.004)
+        cases.arch_tunnel("open_flaw", 0.004)     # the flaw would cut no full row of particles
+    with pytest.raises(ValueError, match="spacing"):
+        cases.arch_tunnel("intact", 1.5 * cases.TUNNEL_INTACT_MAX_SPACING)
 
 
 def test_platen_impact_stress_and_symmetry():
