@@ -19,6 +19,9 @@ echo /usr/lib/x86_64-linux-gnu/yade-double/py > "$site/yade-double.pth"
 echo "$(pwd)/py" > "$site/yade_mpm.pth"
 exec 9>/tmp/yade-mpm-build.lock
 flock 9   # several checkouts/processes may build at once
+# The build is out of the source tree: the modules go to build/py/yade_mpm (py/yade_mpm/_build.py finds them);
+# modules an older build left inside the package folder are removed.
+rm -f py/yade_mpm/_core*.so
 cmake -S . -B build -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 # The build's own exit status decides; its errors and warnings are shown, the rest is in build/setup.log.
 if ! cmake --build build -j2 > build/setup.log 2>&1; then
@@ -26,5 +29,5 @@ if ! cmake --build build -j2 > build/setup.log 2>&1; then
 	echo "[setup] build failed (full log: build/setup.log)"; exit 1
 fi
 grep -E "warning" build/setup.log || true
-test -f py/yade_mpm/_core.so || { echo "[setup] build failed: py/yade_mpm/_core.so missing"; exit 1; }
-echo "[setup] ready: $(cd / && /usr/bin/python3 -c 'import yade, yade_mpm; print("yade", yade.__file__, "| yade_mpm", yade_mpm.__file__)' 2>&1 | tail -1)"
+ls build/py/yade_mpm/_core*.so >/dev/null 2>&1 || { echo "[setup] build failed: build/py/yade_mpm/_core*.so missing"; exit 1; }
+echo "[setup] ready: $(cd / && /usr/bin/python3 -c 'import yade, yade_mpm; print("yade", yade.__file__, "| yade_mpm", yade_mpm.__file__, "| core", yade_mpm._core.__file__)' 2>&1 | tail -1)"

@@ -168,7 +168,7 @@ def main(argv=None):
             frame()
             t_next += a.vtu_every
         O.step()
-        f, _ = s.rigidPartReactions(bodies.parts)
+        f = [bodies.force(b) for b in bodies.ids]                                # reaction on each boulder [N/m]
         J += np.asarray(f) * s.lastDt
         if O.iter % 50 == 0:
             dem_contacts = max(dem_contacts, sum(1 for i in O.interactions if i.isReal))

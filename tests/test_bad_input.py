@@ -42,23 +42,23 @@ def _solver():
 
 def test_empty_particle_set():
     s = _solver()
-    s.setMaterial(ym.ElasticMat(young=1e9, poisson=0.2, density=2500))
+    s._setMaterial(ym.ElasticMat(young=1e9, poisson=0.2, density=2500))
     with pytest.raises(ValueError, match="particles"):
-        s.step()
+        s.run(1)
     with pytest.raises(ValueError, match="empty"):
-        s.addParticles(np.zeros((0, 2)), np.zeros(0), np.zeros(0))
+        s._addParticles(np.zeros((0, 2)), np.zeros(0), np.zeros(0))
 
 
 def test_particle_outside_grid_and_nan_position():
     s = _solver()
     with pytest.raises(ValueError, match="outside the grid"):
-        s.addParticles(np.array([[0.5, 2.0]]), np.array([1e-3]), np.array([1.0]))
+        s._addParticles(np.array([[0.5, 2.0]]), np.array([1e-3]), np.array([1.0]))
     with pytest.raises(ValueError, match="not finite"):
-        s.addParticles(np.array([[np.nan, 0.5]]), np.array([1e-3]), np.array([1.0]))
+        s._addParticles(np.array([[np.nan, 0.5]]), np.array([1e-3]), np.array([1.0]))
     with pytest.raises(ValueError, match="volume"):
-        s.addParticles(np.array([[0.5, 0.5]]), np.array([0.0]), np.array([1.0]))
+        s._addParticles(np.array([[0.5, 0.5]]), np.array([0.0]), np.array([1.0]))
     with pytest.raises(ValueError, match="mass"):
-        s.addParticles(np.array([[0.5, 0.5]]), np.array([1e-3]), np.array([np.inf]))
+        s._addParticles(np.array([[0.5, 0.5]]), np.array([1e-3]), np.array([np.inf]))
     assert s.numParticles == 0                       # nothing was added by the failed calls
 
 
@@ -68,7 +68,7 @@ def test_fixed_dt_above_stable_step():
     s.autoDt = False
     s.fixedDt = 10 * s.stableDt()
     with pytest.raises(ValueError, match="dt .* exceeds the stable time step"):
-        s.step()
+        s.run(1)
     assert s.steps == 0 and s.time == 0
     with pytest.raises(ValueError, match="fixedDt"):
         s.fixedDt = -1.0
@@ -88,7 +88,7 @@ def test_nan_in_state_and_settings():
     s.view("v0")[3] = np.nan                         # NaN written straight into a live view
     s.requestSort()
     with pytest.raises(ValueError, match="velocity of particle id"):
-        s.step()
+        s.run(1)
 
 
 def test_grid_parameters():
@@ -106,11 +106,11 @@ def test_position_corrupted_through_a_view_stops_cleanly():
     # No requestSort() after the edit: the step itself must catch it (not crash, not write NaN).
     s = _solver()
     ym.add_region(s, ym.ElasticMat(young=1e9, poisson=0.2, density=2500), (0, 0), (1, 1))
-    s.step()
+    s.run(1)
     victim = int(s.view("id")[7])
     s.view("x1")[7] = np.nan
     with pytest.raises(ym.MpmSimulationError, match=f"step 1 .*particle id {victim} has a position outside the grid or not finite"):
-        s.step()
+        s.run(1)
 
 
 # ---- wrong types and values at the binding: a ValueError naming the argument and its range
@@ -135,14 +135,14 @@ def _upd(**kw):
     (lambda: ym.Solver3D((0, 0, math.nan), 0.1, (4, 4, 4)), r"Solver3D: origin\[2\] = nan \[m\] is outside"),
     (lambda: _solver().run("a"), r"run: steps must be an integer in \[0, "),
     (lambda: _solver().run(10 ** 20), r"run: steps = 100000000000000000000 is outside"),
-    (lambda: _solver().advance("a"), r"advance: dt must be a number \[s\] in \(0, inf\)"),
+    (lambda: _solver()._advance("a"), r"advance: dt must be a number \[s\] in \(0, inf\)"),
     (lambda: _solver().view(5), r"view: name must be a string \(got int"),
     (lambda: _solver().addBoundaryPlane("a", 1, 0.0, "fixed"), r"addBoundaryPlane: axis must be an integer in \[0, 1\]"),
     (lambda: _solver().addBoundaryPlane(0, 1, math.nan, "fixed"), r"addBoundaryPlane: position = nan \[m\]"),
-    (lambda: _solver().setNodeExcluded(-1, True), r"setNodeExcluded: node = -1 .*outside the allowed range \[0, "),
-    (lambda: _solver().setNodeExcluded(30, "yes"), r"setNodeExcluded: excluded must be True or False"),
-    (lambda: _solver().shapeFunctions("ab"), r"shapeFunctions: point must be a sequence of 2 numbers"),
-    (lambda: _solver().setMaterial(None), r"setMaterial: material must be an ElasticMat or a DpGkMat \(got NoneType\)"),
+    (lambda: _solver()._setNodeExcluded(-1, True), r"setNodeExcluded: node = -1 .*outside the allowed range \[0, "),
+    (lambda: _solver()._setNodeExcluded(30, "yes"), r"setNodeExcluded: excluded must be True or False"),
+    (lambda: _solver()._shapeFunctions("ab"), r"shapeFunctions: point must be a sequence of 2 numbers"),
+    (lambda: _solver()._setMaterial(None), r"setMaterial: material must be an ElasticMat or a DpGkMat \(got NoneType\)"),
     (lambda: ym.setThreads(2.5), r"setThreads: threads must be an integer in \[1, \d+\]"),
     (lambda: ym.setThreads(0), r"setThreads: threads = 0 .*outside the allowed range \[1, \d+\]"),
     # dpgkPointUpdate took NaN increments (NaN state out) and negative dt
@@ -268,7 +268,7 @@ def test_damage_state_out_of_range_through_views_refused(field, value, msg):
     s.requestSort()
     pid = int(s.view("id")[11])
     with pytest.raises(ValueError, match=msg.format(pid=pid)):
-        s.step()
+        s.run(1)
     assert (s.steps, s.time) == (steps, t)            # refused before any work
 
 
@@ -283,12 +283,12 @@ def test_damage_threshold_outside_unit_interval_refused():
     low = ym.rocks.granite_dpgk(weibullK=100.0, thresholdVolume="particle")   # V k = 0.25: ε_D⁰ = 0.25^(−1/7.5) ≈ 1.2
     with pytest.raises(ValueError, match=r"damage threshold eps0 = .* = 1.2.* for V = 0.0025 m³ \(particle volume 0.0025 m³, "
                                          r"thresholdVolume = 'particle'\) is outside the allowed range \(0, 1\) .*V·weibullK = 0.25 must exceed 1"):
-        s.setMaterial(low)
-    assert s.dpgkParameters().weibullK == 1e3          # refused before anything changed
+        s._setMaterial(low)
+    assert s.material(0).weibullK == 1e3          # refused before anything changed
     s2 = _solver()
-    s2.setMaterial(low)                                # no particles yet: nothing to check
+    s2._setMaterial(low)                                # no particles yet: nothing to check
     with pytest.raises(ValueError, match=r"V·weibullK = 0.25 must exceed 1"):
-        s2.addParticles(np.array([[0.5, 0.5]]), np.array([2.5e-3]), np.array([6.0]))
+        s2._addParticles(np.array([[0.5, 0.5]]), np.array([2.5e-3]), np.array([6.0]))
     assert s2.numParticles == 0
 
 
@@ -297,19 +297,19 @@ def test_set_particle_forces_is_all_or_nothing():
     had been applied (a half-applied load)."""
     s = _solver()
     ym.add_region(s, ym.rocks.granite(), (0, 0), (1, 1))
-    s.setParticleForces([0], [[1.0, 2.0]])
+    s._setParticleForces([0], [[1.0, 2.0]])
     n = s.numParticles
     for idx, f, msg in (([0, n + 5], [[3.0, 4.0], [5.0, 6.0]], rf"particle index {n + 5} is outside the allowed range \[0, {n}\)"),
                         ([0, 1], [[3.0, 4.0], [np.nan, 6.0]], "particle surface force must be a finite number")):
         with pytest.raises(ValueError, match=msg):
-            s.setParticleForces(idx, f)
+            s._setParticleForces(idx, f)
         assert (s.view("trac0")[0], s.view("trac1")[0]) == (1.0, 2.0)
 
 
 @pytest.mark.parametrize("call, msg", [
-    (lambda: _solver().setParticleForces(np.zeros(1), [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
-    (lambda: _solver().setParticleForces(10 ** 20, [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
-    (lambda: _solver().setParticleForces([], []), r"forces must be an \(N, 2\) array"),
+    (lambda: _solver()._setParticleForces(np.zeros(1), [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
+    (lambda: _solver()._setParticleForces(10 ** 20, [[0.0, 1.0]]), r"setParticleForces: indices must be a 1-D array of integer"),
+    (lambda: _solver()._setParticleForces([], []), r"forces must be an \(N, 2\) array"),
     (lambda: ym.make_solver((0, 0), (1, 1), True), r"spacing must be a number \[m\] \(got bool True\)"),
     (lambda: ym.get(None, "pos"), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
     (lambda: ym.MpmEngine(None), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),

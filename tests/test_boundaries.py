@@ -102,7 +102,7 @@ def test_plane_placement_is_checked():
         s.addBoundaryPlane(0, 1, 0.2, "fixed")
     ym.add_region(s, ym.ElasticMat(**MAT), (0, 0), (1, 1))  # particles at x = 0.025 lie beyond x = 0.05
     with pytest.raises(ValueError, match="cut by the boundary planes"):
-        s.step()
+        s.run(1)
 
 
 def _crack(h, c, gap_nodes="excluded", size=1.2):
@@ -115,27 +115,27 @@ def _crack(h, c, gap_nodes="excluded", size=1.2):
 def test_thin_gap_nodes_are_the_crack_midline_only():
     h, c = 0.05, 0.2
     s, xc = _crack(h, c)
-    gap = np.nonzero(s.excludedNodes() & GAP)[0]
-    xn = s.nodePositions()[gap]
+    gap = np.nonzero(s._excludedNodes() & GAP)[0]
+    xn = s._nodePositions()[gap]
     # the nodes strictly between the faces: mid-line, |x − xc| < c (tips on node lines here)
     np.testing.assert_allclose(xn[:, 1], xc, atol=1e-12)
     np.testing.assert_allclose(np.sort(xn[:, 0]), xc + h * np.arange(-3, 4), atol=1e-12)
     s2, _ = _crack(h, c, gap_nodes="shared")
-    assert not np.any(s2.excludedNodes() & GAP)
+    assert not np.any(s2._excludedNodes() & GAP)
     # a hole wider than the kernel (radius 2.5 cells) and a big opening keep all their nodes
     s3 = ym.make_solver((0, 0), (1, 1), 0.04)
     ym.add_region(s3, ym.ElasticMat(**MAT), (0, 0), (1, 1), holes=[ym.Circle((0.52, 0.52), 0.1)])
-    assert not np.any(s3.excludedNodes() & GAP)
+    assert not np.any(s3._excludedNodes() & GAP)
     s4 = ym.make_solver((0, 0), (0.15, 0.15), 0.003)
     ym.add_region(s4, ym.ElasticMat(**MAT), (0, 0), (0.15, 0.15), holes=cases.arch_tunnel_holes())
-    assert not np.any(s4.excludedNodes() & GAP)
+    assert not np.any(s4._excludedNodes() & GAP)
 
 
 def _assert_linear_exact_fits(s, pts, grad_tol):
     """At every point a non-singular WLS fit that reproduces 1, x and the constant gradient (Eqs. 10–15)."""
-    xn = s.nodePositions()
+    xn = s._nodePositions()
     for x in pts:
-        idx, psi, grad, _ = s.shapeFunctions(tuple(x))
+        idx, psi, grad, _ = s._shapeFunctions(tuple(x))
         np.testing.assert_allclose(psi.sum(), 1, atol=1e-10)
         np.testing.assert_allclose(psi @ xn[idx], x, atol=1e-10)
         np.testing.assert_allclose(grad.T @ xn[idx], np.eye(2), atol=grad_tol)
@@ -150,7 +150,7 @@ def test_points_inside_a_thin_gap_keep_a_valid_fit(width, angle, tied):
     s = ym.make_solver((0, 0), (1.2, 1.2), h)
     flaw = ym.geometry.rotated_rectangle((0.6, 0.6), 0.5, width * h, angle)
     ym.add_region(s, ym.ElasticMat(**MAT), (0, 0), (1.2, 1.2), holes=[flaw])
-    assert np.any(s.excludedNodes() & GAP) == tied
+    assert np.any(s._excludedNodes() & GAP) == tied
     rng = np.random.default_rng(1)
     pts = rng.uniform(0.3, 0.9, size=(4000, 2))
     pts = pts[flaw.contains(pts)]
@@ -171,7 +171,7 @@ def test_faces_of_a_thin_crack_move_independently_and_closing_does_not_stop_the_
         s.requestSort()
         s.autoDt = False
         s.fixedDt = 1e-7
-        s.step()
+        s.run(1)
         v = ym.get(s, "vel")
         bot = (np.abs(x[:, 0] - xc) < c - 2 * h) & (np.abs(x[:, 1] - (xc - 1.25 * h)) < 1e-9)
         res[mode] = np.abs(v[bot, 1]).max()
@@ -197,7 +197,7 @@ def test_open_flaw_exclusion_only_when_thinner_than_the_stencil(spacing, thin):
     s = ym.make_solver(tuple(c - 0.02), tuple(c + 0.02), spacing)
     ym.add_region(s, ym.ElasticMat(**MAT), tuple(c - 0.02), tuple(c + 0.02), holes=[fl["polygon"]])
     n = cases.exclude_nodes_inside(s, fl["polygon"])
-    assert (n > 0) == thin and (np.count_nonzero(s.excludedNodes() & GAP) >= n)
+    assert (n > 0) == thin and (np.count_nonzero(s._excludedNodes() & GAP) >= n)
     rng = np.random.default_rng(2)
     pts = c + rng.uniform(-0.013, 0.013, size=(6000, 2))
     pts = pts[fl["polygon"].contains(pts)]

@@ -31,13 +31,13 @@ def _block_on_incline(d, theta, mu, cohesion=0.0, chi=0.5, shift=(0.0, 0.0, 0.0)
     c0 = np.array([0.5, 0.3, 0.2][:d]) + np.asarray(shift[:d]) * l
     x = c0 + loc @ R.T
     s = ym.make_solver(np.zeros(d), (1.0, 0.8, 0.4)[:d], l)
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
-    s.addParticles(x, np.full(len(x), sp ** d), np.full(len(x), sp ** d * ELASTIC["density"]))
+    s._setMaterial(ym.ElasticMat(**ELASTIC))
+    s._addParticles(x, np.full(len(x), sp ** d), np.full(len(x), sp ** d * ELASTIC["density"]))
     s.gravity = (0, -G, 0)[:d]
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=mu, cohesion=cohesion, chi=chi, d0=None))
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), (1.0, 0.1, 1.0)[:d])
-    s.setRigidPartState(p, c0 - 0.1 * R[:, 1], R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=mu, cohesion=cohesion, chi=chi, d0=None))
+    s._addContactBox(g, p, np.zeros(d), np.eye(d), (1.0, 0.1, 1.0)[:d])
+    s._setRigidPartState(p, c0 - 0.1 * R[:, 1], R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s, p, R[:, 0], l, s.view("mass").sum()
 
 
@@ -50,7 +50,7 @@ def _slide(s, d, t_end, t_fit):
     """Centre-of-mass (time, position along the slope, velocity along the slope) history."""
     out = []
     while s.time < t_end:
-        s.step()
+        s.run(1)
         out.append((s.time, _com(s, d, "x"), _com(s, d, "v")))
     return out
 
@@ -116,12 +116,12 @@ def _drop(d, chi=None):
     s = ym.make_solver((0, -0.05, 0)[:d], (0.4, 0.4, 0.16)[:d], l)
     ym.add_region(s, ym.ElasticMat(young=1e6, poisson=0.25, density=1000.0), (0.1, 0.1, 0.04)[:d], (0.3, 0.2, 0.12)[:d])
     s.gravity = (0, -G, 0)[:d]
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=None))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=None))
     n = np.zeros(d)
     n[1] = 1
-    s.addContactPlane(g, p, np.zeros(d), n, False)   # the wall y = 0, material above
-    s.setRigidPartState(p, np.zeros(d), np.eye(d), np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
+    s._addContactPlane(g, p, np.zeros(d), n, False)   # the wall y = 0, material above
+    s._setRigidPartState(p, np.zeros(d), np.eye(d), np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s
 
 
@@ -135,7 +135,7 @@ def test_dropped_block_rebounds_without_energy_gain(d):
     e0, y0 = energy(), _com(s, d, "x")[1]
     emax, ymin, hist = e0, np.inf, []
     while s.time < 0.45:
-        s.step()
+        s.run(1)
         emax = max(emax, energy())
         ymin = min(ymin, s.view("x1").min())
         hist.append((_com(s, d, "x")[1], _com(s, d, "v")[1]))
@@ -159,23 +159,23 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d, law, down, lif
     s = ym.make_solver((0, 0, 0)[:d], (1, 1, 0.6)[:d], l)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0.2, 0.2, 0.1)[:d], (0.8, 0.5, 0.5)[:d])
     s.gravity = (0.3, -G, 0.2)[:d]
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.4, cohesion=1e3, chi=0.5, d0=None, law=law))
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), (0.15, 0.1, 0.15)[:d])
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.4, cohesion=1e3, chi=0.5, d0=None, law=law))
+    s._addContactBox(g, p, np.zeros(d), np.eye(d), (0.15, 0.1, 0.15)[:d])
     c = np.array([0.45, 0.59 + lift, 0.3][:d])
     R = _rot(d, 0.2)
     v = np.array([0.3, -down, 0.1][:d])
     w = 2.0 if d == 2 else (0.5, 0.3, 2.0)
-    X = s.nodePositions()
+    X = s._nodePositions()
     m = s.view("mass")
     checked = 0
     for k in range(60):
-        s.setRigidPartState(p, c + v * s.time, R, v, w)
+        s._setRigidPartState(p, c + v * s.time, R, v, w)
         p0 = np.array([m @ s.view(f"v{a}") for a in range(d)])
-        s.step()
+        s.run(1)
         p1 = np.array([m @ s.view(f"v{a}") for a in range(d)])
-        fn = s.contactNodeForces()
-        F, T = np.array(s.rigidPartForce(p)), np.array(s.rigidPartTorque(p))
+        fn = s._contactNodeForces()
+        F, T = np.array(s._rigidPartForce(p)), np.array(s._rigidPartTorque(p))
         if not np.any(F):
             continue
         checked += 1
@@ -201,13 +201,13 @@ def test_contact_is_bitwise_identical_for_1_and_2_threads(free, law, damping, mo
         ym.setThreads(n)
         try:
             s, *_ = _block_on_incline(2, np.radians(30), 0.3)
-            assert s.contactParams(0).law == law
+            assert s._contactParams(0).law == law
             s.damping = damping
             if free:
-                s.setRigidPartMass(0, 5.0, 0.5)
+                s._setRigidPartMass(0, 5.0, 0.5)
             for _ in range(150):
-                s.step()
-            return ym.get(s, "pos"), ym.get(s, "vel"), s.rigidPartForce(0)
+                s.run(1)
+            return ym.get(s, "pos"), ym.get(s, "vel"), s._rigidPartForce(0)
         finally:
             ym.setThreads(old)
     old = ym.getThreads()
@@ -218,9 +218,9 @@ def test_contact_is_bitwise_identical_for_1_and_2_threads(free, law, damping, mo
 
 def test_nodes_covered_by_a_body_are_excluded_and_released():
     s = _drop(2)
-    X = s.nodePositions()
-    s.step()
-    ex = s.excludedNodes()
+    X = s._nodePositions()
+    s.run(1)
+    ex = s._excludedNodes()
     inside = (X[:, 1] < -1e-12) & (X[:, 1] > -0.05) & (X[:, 0] > 0.01) & (X[:, 0] < 0.39)
     bit = ym._core.exclusionBits["contact"]
     assert np.all(ex[inside] & bit)                      # covered by the wall: contact bit

@@ -29,7 +29,7 @@ def _corner_drop(d, shift):
     off = np.zeros(d)
     off[:2] = np.asarray(shift) * l
     s = ym.make_solver(np.zeros(d), np.full(d, 1.0) if d == 2 else (1.0, 1.0, 0.4), l)
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
+    s._setMaterial(ym.ElasticMat(**ELASTIC))
     h = 0.1                                                   # box half edge
     c = np.array([0.5, 0.4, 0.2][:d]) + off                   # box centre
     R = _rot(d, math.pi / 4)
@@ -42,13 +42,13 @@ def _corner_drop(d, shift):
     dims = np.array([0.2, 0.1, 0.1][:d])
     axes = [np.arange(sp / 2, dims[a], sp) + lo[a] for a in range(d)]
     X = np.column_stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")])
-    s.addParticles(X, np.full(len(X), sp ** d), np.full(len(X), sp ** d * ELASTIC["density"]))
+    s._addParticles(X, np.full(len(X), sp ** d), np.full(len(X), sp ** d * ELASTIC["density"]))
     s.view("v1")[:] = -0.5
     s.gravity = tuple(-G if a == 1 else 0.0 for a in range(d))
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.3, cohesion=0.0, chi=0.5, d0=None))
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), np.full(d, h))
-    s.setRigidPartState(p, c, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.3, cohesion=0.0, chi=0.5, d0=None))
+    s._addContactBox(g, p, np.zeros(d), np.eye(d), np.full(d, h))
+    s._setRigidPartState(p, c, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
     return s, g, top, l
 
 
@@ -62,14 +62,14 @@ def test_block_dropped_on_a_box_corner(d, shift):
     e0 = energy()
     emax, dmin, hit, t_end = e0, np.inf, False, 0.12 if d == 2 else 0.08
     while s.time < t_end:
-        s.step()
+        s.run(1)
         emax = max(emax, energy())
         X = np.column_stack([s.view(f"x{a}") for a in range(d)])
         near = np.abs(X[:, 1] - top) < 0.1
-        dist = [s.contactQuery(g, tuple(x))[0] for x in X[near]]
+        dist = [s._contactQuery(g, tuple(x))[0] for x in X[near]]
         if dist:
             dmin = min(dmin, min(dist))
-        hit = hit or np.any(s.contactNodeForces())
+        hit = hit or np.any(s._contactNodeForces())
     print(f"d={d} shift={np.round(shift, 3)}: max E/E0 − 1 = {emax / e0 - 1:.2e}, closest particle centre {dmin / l:.3f} cell "
           f"outside the box")
     assert hit                                                # it landed on the corner
@@ -106,7 +106,7 @@ def test_free_box_turning_in_a_slot():
         near = np.abs(X[:, 1] - 0.2) < 0.05
         rec.append((m @ s.view("v0") + M * v[0], m @ s.view("v1") + M * v[1],
                     s.kineticEnergy() + s.elasticEnergy() + 0.5 * M * v.squaredNorm() + 0.5 * I * b.state.angVel[2] ** 2,
-                    min(s.contactQuery(g, tuple(x))[0] for x in X[near]), angle * np.sign(axis[2])))
+                    min(s._contactQuery(g, tuple(x))[0] for x in X[near]), angle * np.sign(axis[2])))
     rb = _yade_scene([(bid, dict(mu=0.3))], s, "mpmSlot", record=record)
     g = rb.groups[0]
     e0 = 0.5 * I * w0 ** 2

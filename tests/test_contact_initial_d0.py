@@ -26,13 +26,13 @@ def _lattice_with_box(theta, d=2):
     R[:2, :2] = [[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]]
     centre, half = np.full(d, L / 2), np.asarray(half)
     x = x[~np.all(np.abs((x - centre) @ R) <= half, axis=1)]   # centres inside the box (its frame) removed
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
-    s.addParticles(x, np.full(len(x), dp ** d), np.full(len(x), dp ** d * ELASTIC["density"]))
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), half)
-    s.setRigidPartState(p, centre, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
-    s.captureContactD0(g)
+    s._setMaterial(ym.ElasticMat(**ELASTIC))
+    s._addParticles(x, np.full(len(x), dp ** d), np.full(len(x), dp ** d * ELASTIC["density"]))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
+    s._addContactBox(g, p, np.zeros(d), np.eye(d), half)
+    s._setRigidPartState(p, centre, R, np.zeros(d), 0.0 if d == 2 else (0, 0, 0))
+    s._captureContactD0(g)
     return s, g, ym.get(s, "pos"), centre, R, half, dp
 
 
@@ -45,7 +45,7 @@ def test_first_layer_is_one_particle_per_lattice_line_along_an_inclined_face(deg
     depth); its d0 is its distance."""
     theta = math.radians(deg)
     s, g, x, c, R, h, dp = _lattice_with_box(theta, d)
-    d0 = s.contactInitialD0(g)
+    d0 = s._contactInitialD0(g)
     assert len(d0) == len(x)
     sel = ~np.isnan(d0)
     n = R[:, 1]                                          # outward normal of the upper long face
@@ -76,12 +76,12 @@ def _slab_on_block(d0, gap, l=0.02, chi=0.5):
     block's top face (the top row at dp/2 + gap); the slab registered with d0. Returns (solver, part, dp)."""
     s = ym.make_solver((0, 0), (0.2, 0.2), l)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (0.2, 0.1), ppc=2)
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0, law="penalty"))
-    s.addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
-    s.setRigidPartState(p, (0.1, 0.1 + gap + 0.02), np.eye(2), (0, 0), 0.0)
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=chi, d0=d0, law="penalty"))
+    s._addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
+    s._setRigidPartState(p, (0.1, 0.1 + gap + 0.02), np.eye(2), (0, 0), 0.0)
     if d0 == "initial":
-        s.captureContactD0(g)
+        s._captureContactD0(g)
     return s, p, l / 2
 
 
@@ -95,11 +95,11 @@ def test_pushed_slab_force_is_the_penalty_of_the_first_layer(chi):
     for d0 in ("initial", None):
         s, p, _ = _slab_on_block(d0, 0.3 * dp, l=l, chi=chi)
         delta = 0.1 * dp
-        s.setRigidPartState(p, (0.1, 0.1 + 0.3 * dp + 0.02 - delta), np.eye(2), (0, 0), 0.0)
+        s._setRigidPartState(p, (0.1, 0.1 + 0.3 * dp + 0.02 - delta), np.eye(2), (0, 0), 0.0)
         top = np.abs(ym.get(s, "pos")[:, 1] - (0.1 - dp / 2)) < 1e-9
         m = s.view("mass")[0]
-        s.step()
-        f = np.array(s.rigidPartForce(p))
+        s.run(1)
+        f = np.array(s._rigidPartForce(p))
         if d0 == "initial":
             expect = top.sum() * (1 - chi) * 2 * m / s.lastDt ** 2 * delta
             assert top.sum() == 20
@@ -115,23 +115,23 @@ def test_initial_d0_bad_input_is_refused():
     s, p, dp = _slab_on_block(None, 0.0)
     for bad in ("Initial", "init", "", True):
         with pytest.raises(ValueError, match="d0"):
-            s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=bad))
+            s._addContactGroup([s._addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=bad))
     s = ym.make_solver((0, 0), (0.2, 0.2), 0.02)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (0.2, 0.1), ppc=2)
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
-    s.addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
-    s.setRigidPartState(p, (0.1, 0.1 + 0.02 - 0.006), np.eye(2), (0, 0), 0.0)   # 6 mm into the block
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0="initial"))
+    s._addContactBox(g, p, (0, 0), np.eye(2), (0.2, 0.02))
+    s._setRigidPartState(p, (0.1, 0.1 + 0.02 - 0.006), np.eye(2), (0, 0), 0.0)   # 6 mm into the block
     with pytest.raises(ValueError, match="particle id .* inside the rigid body"):
-        s.captureContactD0(g)
-    s.setRigidPartState(p, (0.1, 0.1 + 0.02), np.eye(2), (0, 0), 0.0)
+        s._captureContactD0(g)
+    s._setRigidPartState(p, (0.1, 0.1 + 0.02), np.eye(2), (0, 0), 0.0)
     with pytest.raises(ValueError, match="captureInitialD0"):
-        s.step()
-    s.captureContactD0(g)
-    s.step()
-    g2 = s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
+        s.run(1)
+    s._captureContactD0(g)
+    s.run(1)
+    g2 = s._addContactGroup([s._addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
     with pytest.raises(ValueError, match="not created with d0 = 'initial'"):
-        s.captureContactD0(g2)
+        s._captureContactD0(g2)
 
 
 # ---------------------------------------------------------------- a column with a slab in a cut (YADE)
@@ -207,7 +207,7 @@ def test_rigid_bodies_initial_d0_input_is_checked_before_registering():
     inside = O.bodies.append(utils.box((0.2, 0.1, 0), (0.05, 0.006, 0.1)))    # across the block's top row
     with pytest.raises(ValueError, match="particle id .* inside the rigid body"):
         rb.add(inside, d0="initial")
-    assert not s.contactActive and rb.ids == [] and rb.groups == []
+    assert not s._contactActive and rb.ids == [] and rb.groups == []
     g = rb.add(box, d0="initial")                       # 0.05 m above the block: nobody in the first layer
     assert rb.groups == [g] and np.all(np.isnan(rb.initial_d0(g)))
     sphere = O.bodies.append(utils.sphere((0.2, 0.25, 0), 0.01))
@@ -234,7 +234,7 @@ def test_free_filler_moves_smoothly_at_its_true_mass():
     builtins._filler_vel = lambda: vel.append(st.vel[0] * u[0] + st.vel[1] * u[1])
     O.engines = O.engines + [PyRunner(command="_filler_vel()", iterPeriod=1)]
     O.run(400, True)
-    f, m = s.contactNodeForces(), s.nodeState()[0]            # the filler is the last contact group
+    f, m = s._contactNodeForces(), s._nodeState()[0]            # the filler is the last contact group
     assert m[np.any(f != 0, axis=1)].sum() > 1.5 * st.mass     # lighter than its contact nodes
     dv = np.diff(vel[-100:])
     assert int(np.sum(np.sign(dv[1:]) != np.sign(dv[:-1]))) < 20

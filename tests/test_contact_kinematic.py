@@ -18,7 +18,7 @@ def kinematic(monkeypatch):
 def test_incline_slides_with_coulomb_acceleration(kinematic, d):
     theta, mu = np.radians(30), 0.3
     s, _, t, l, _ = tc._block_on_incline(d, theta, mu)
-    assert s.contactParams(0).law == "kinematic"
+    assert s._contactParams(0).law == "kinematic"
     h = tc._slide(s, d, 0.1, 0.03)
     tt = np.array([x[0] for x in h])
     v = np.array([x[2] @ t for x in h])
@@ -52,21 +52,21 @@ def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     ym.add_region(s, ym.ElasticMat(young=E, poisson=nu, density=1000.0), (0, 0), (W, H), ppc=ppc)
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping, s.courant = 0.5, courant
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, d0=None, law=law))
-    s.addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, d0=None, law=law))
+    s._addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
     face, stop = H + 0.37e-3, H - 1e-4               # the top particles' faces are at H: contact from face = H
     while face > stop:
-        s.setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, -v), 0.0)
-        s.step()
+        s._setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, -v), 0.0)
+        s.run(1)
         face -= v * s.lastDt
     for _ in range(int(0.06 / s.lastDt)):
-        s.setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, 0.0), 0.0)
-        s.step()
+        s._setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, 0.0), 0.0)
+        s.run(1)
     y = s.view("x1")
     top = np.argmax(y)
     overlap = (y[top] + 0.5 * np.sqrt(s.view("vol")[top]) - face) / l
-    return (s.rigidPartForce(p)[1] / W) / ((H - face) / H) / (E / (1 - nu ** 2)), overlap
+    return (s._rigidPartForce(p)[1] / W) / ((H - face) / H) / (E / (1 - nu ** 2)), overlap
 
 
 def test_elastic_platen_modulus_is_independent_of_the_time_step_and_the_limit_of_eq23():

@@ -44,7 +44,7 @@ def _run(s, d, R, c0, l, t_end):
     t, n = R[:, 0], R[:, 1]
     hist, lift = [], 0.0
     while s.time < t_end:
-        s.step()
+        s.run(1)
         hist.append((s.time, _com(s, d, "x") @ t, _com(s, d, "v") @ t))
         x = np.column_stack([s.view(f"x{a}") for a in range(d)])
         lift = max(lift, ((x - c0) @ n).min() - l / 4)     # bottom row starts l/4 above the surface
@@ -96,7 +96,7 @@ def test_sticking_from_equilibrium_on_every_grid_shift(d, theta, mu, limit, rela
         if relax:                                   # to the block's own equilibrium, then no damping
             s.damping = 0.3
             while s.time < relax:
-                s.step()
+                s.run(1)
             s.damping = 0.0
         h, lift = _run(s, d, R, c0, l, relax + (0.3 if d == 2 else 0.15))
         drifts.append(np.abs(h[:, 1] - h[0, 1]).max() / l)
@@ -127,27 +127,27 @@ def test_block_on_rotating_plate_follows_it(omega):
     particles move at ω × r."""
     l, sp = 0.02, 0.01
     s = ym.make_solver((0, 0), (1.2, 1.0), l)
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
+    s._setMaterial(ym.ElasticMat(**ELASTIC))
     c = np.array([0.6 + 0.23 * l, 0.4 + 0.37 * l])          # plate centre, off the grid lines
     top = c[1] + 0.1
     axes = [np.arange(sp / 2, 0.2, sp) + c[0] - 0.1, np.arange(sp / 2, 0.1, sp) + top]
     X0 = np.column_stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")])
-    s.addParticles(X0, np.full(len(X0), sp ** 2), np.full(len(X0), sp ** 2 * ELASTIC["density"]))
+    s._addParticles(X0, np.full(len(X0), sp ** 2), np.full(len(X0), sp ** 2 * ELASTIC["density"]))
     s.gravity = (0, -G)
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=1.0, cohesion=0.0, chi=0.5, d0=None))
-    s.addContactBox(g, p, np.zeros(2), np.eye(2), (0.4, 0.1))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=1.0, cohesion=0.0, chi=0.5, d0=None))
+    s._addContactBox(g, p, np.zeros(2), np.eye(2), (0.4, 0.1))
     ramp, t_end, angle = 0.1, 0.15, 0.0
-    s.setRigidPartState(p, c, np.eye(2), np.zeros(2), 0.0)
+    s._setRigidPartState(p, c, np.eye(2), np.zeros(2), 0.0)
     for _ in range(20):                                     # settle on the plate at rest
-        s.step()
+        s.run(1)
     Xs, t0 = _xy_by_id(s), s.time
     E, ES = [], []
     while s.time - t0 < t_end:
         tau = s.time - t0
         w = omega * min(tau / ramp, 1.0)
-        s.setRigidPartState(p, c, _rot(2, angle), np.zeros(2), w)
-        s.step()
+        s._setRigidPartState(p, c, _rot(2, angle), np.zeros(2), w)
+        s.run(1)
         angle += w * s.lastDt
         if tau > ramp:
             o = id_order(s)
@@ -178,19 +178,19 @@ def test_held_column_with_damping_reaction_equals_section_force():
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0, 0), (W, H), ppc=2)
     s.addBoundaryPlane(0, -1, 0.0, "slip"), s.addBoundaryPlane(0, 1, W, "slip"), s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping = 0.5
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
-    s.addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=0.5, d0=None))
+    s._addContactBox(g, p, np.zeros(2), np.eye(2), (W, 0.005))
     face, stop = H + 0.37e-3, H - 1e-4                      # platen face: start, and where it is held
     while face > stop:
-        s.setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, -v), 0.0)
-        s.step()
+        s._setRigidPartState(p, (W / 2, face + 0.005), np.eye(2), (0.0, -v), 0.0)
+        s.run(1)
         face -= v * s.lastDt
     y = face + 0.005
     for _ in range(4000):
-        s.setRigidPartState(p, (W / 2, y), np.eye(2), (0.0, 0.0), 0.0)
-        s.step()
-    F = s.rigidPartForce(p)[1]                              # force of the rock on the platen, upwards
+        s._setRigidPartState(p, (W / 2, y), np.eye(2), (0.0, 0.0), 0.0)
+        s.run(1)
+    F = s._rigidPartForce(p)[1]                              # force of the rock on the platen, upwards
     y = s.view("x1")
     mid = (y > H / 3) & (y < 2 * H / 3)                     # a section away from the platen and the base
     section = -s.view("sig1")[mid].mean() * W

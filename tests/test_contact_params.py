@@ -85,8 +85,8 @@ def _incline_scene(theta, material, **add_kw):
     c0 = np.array([0.5, 0.3])
     x = c0 + loc @ R.T
     s = ym.make_solver((0, 0), (1.0, 0.8), l)
-    s.setMaterial(ym.ElasticMat(**ELASTIC))
-    s.addParticles(x, np.full(len(x), sp ** 2), np.full(len(x), sp ** 2 * ELASTIC["density"]))
+    s._setMaterial(ym.ElasticMat(**ELASTIC))
+    s._addParticles(x, np.full(len(x), sp ** 2), np.full(len(x), sp ** 2 * ELASTIC["density"]))
     s.gravity = (0, -G)
     centre = c0 - 0.1 * R[:, 1]
     box = O.bodies.append(utils.box((centre[0], centre[1], 0), (1.0, 0.1, 0.1), orientation=Quaternion(Vector3(0, 0, 1), theta),
@@ -105,7 +105,7 @@ def test_box_friction_from_yade_frictmat_slides_with_coulomb_acceleration():
     from yade.wrapper import FrictMat
     theta = math.radians(30)
     s, rb, box, t = _incline_scene(theta, FrictMat(frictionAngle=math.atan(0.35), density=1000))
-    assert s.contactParams(rb.groups[0]).mu == pytest.approx(0.35, rel=1e-12)
+    assert s._contactParams(rb.groups[0]).mu == pytest.approx(0.35, rel=1e-12)
     m = s.view("mass")
     hist = []
     while O.time < 0.1:
@@ -122,13 +122,13 @@ def test_explicit_mu_wins_and_mixed_friction_angles_need_mu():
     from yade import O, utils
     from yade.wrapper import FrictMat
     s, rb, box, _ = _incline_scene(0.0, FrictMat(frictionAngle=0.3), mu=0.0)
-    assert s.contactParams(rb.groups[0]).mu == 0.0
+    assert s._contactParams(rb.groups[0]).mu == 0.0
     a = O.bodies.append(utils.box((0.5, 0.7, 0), (0.05, 0.02, 0.1), material=FrictMat(frictionAngle=0.2)))
     b = O.bodies.append(utils.box((0.7, 0.7, 0), (0.05, 0.02, 0.1), material=FrictMat(frictionAngle=0.4)))
     with pytest.raises(ValueError, match="different friction angles.*pass mu"):
         rb.add([a, b])
     g = rb.add([a, b], mu=0.1)
-    assert s.contactParams(g).mu == 0.1
+    assert s._contactParams(g).mu == 0.1
 
 
 def _block_and_box():
@@ -154,7 +154,7 @@ def test_bad_registration_is_refused_before_any_work(ids, kw, msg):
     rb = ym.RigidBodies(s)
     with pytest.raises(ValueError, match=msg):
         rb.add(ids, **kw)
-    assert not s.contactActive and s.numContactGroups == 0 and rb.ids == []
+    assert not s._contactActive and s._numContactGroups == 0 and rb.ids == []
 
 
 def test_numpy_scalars_are_numbers():
@@ -163,7 +163,7 @@ def test_numpy_scalars_are_numbers():
     rb = ym.RigidBodies(s)
     g = rb.add(np.int64(box), mu=np.float32(0.3), cohesion=np.int64(1000), chi=np.float64(0.25), d0=np.float32(0.005),
                thickness=np.float32(0.2))
-    p = s.contactParams(g)
+    p = s._contactParams(g)
     assert p.mu == pytest.approx(0.3, rel=1e-7) and p.cohesion == 1000 and p.chi == 0.25 and not p.autoD0
     assert rb.thickness(box) == pytest.approx(0.2, rel=1e-7)
 
@@ -178,7 +178,7 @@ def test_dem_sphere_with_nan_position_is_refused():
     sp = ym.DemSpheres(s)
     with pytest.raises(ValueError, match=rf"body id {bad}: state.pos = \(nan, 0.2, 0(.0)?\) \[m\] must be finite"):
         sp.add([bad])
-    assert s.numContactGroups == 0
+    assert s._numContactGroups == 0
     O.bodies[bad].state.pos = (0.2, 0.25, 0.0)
     sp.add([bad], mu=0.0)
     O.bodies[bad].state.pos = (0.2, float("nan"), 0.0)
@@ -188,11 +188,11 @@ def test_dem_sphere_with_nan_position_is_refused():
 
 def test_rigid_body_velocity_message_has_its_unit():
     s = ym.make_solver((0, 0), (0.4, 0.3), 0.02)
-    p = s.addRigidPart()
+    p = s._addRigidPart()
     with pytest.raises(ValueError, match=r"rigid body velocity\[0\] = nan \[m/s\]"):
-        s.setRigidPartState(p, (0, 0), np.eye(2), (float("nan"), 0), 0.0)
+        s._setRigidPartState(p, (0, 0), np.eye(2), (float("nan"), 0), 0.0)
     with pytest.raises(ValueError, match=r"rigid body position\[1\] = inf \[m\]"):
-        s.setRigidPartState(p, (0, float("inf")), np.eye(2), (0, 0), 0.0)
-    s.addContactGroup([p], ym.ContactParams())
+        s._setRigidPartState(p, (0, float("inf")), np.eye(2), (0, 0), 0.0)
+    s._addContactGroup([p], ym.ContactParams())
     with pytest.raises(ValueError, match=r"rigid body velocity \[m/s\] must be a finite number"):
-        s.setRigidPartMotions([p], [[0.0, 0.0]], [[float("nan"), 0.0]], [[0.0]])
+        s._setRigidPartMotions([p], [[0.0, 0.0]], [[float("nan"), 0.0]], [[0.0]])

@@ -26,20 +26,20 @@ def _box_sliding_on_slab(d, mass, inertia, v0=0.1, pen=0.002):
     part, box centre)."""
     s = ym.make_solver(np.zeros(d), (0.4, 0.2, 0.2)[:d], L)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, 0.0, 0.05)[:d], (0.3, TOP, 0.15)[:d])
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
     half = (0.2, 0.02, 0.2)[:d]                  # flat bottom face over the whole slab: normals exactly −y
-    s.addContactBox(g, p, np.zeros(d), np.eye(d), half)
+    s._addContactBox(g, p, np.zeros(d), np.eye(d), half)
     c = np.array((0.2, TOP + 0.02 - pen, 0.1)[:d])
-    s.setRigidPartState(p, c, np.eye(d), (v0,) + (0.0,) * (d - 1), 0.0 if d == 2 else (0.0, 0.0, 0.0))
-    s.setRigidPartMass(p, mass, inertia)
+    s._setRigidPartState(p, c, np.eye(d), (v0,) + (0.0,) * (d - 1), 0.0 if d == 2 else (0.0, 0.0, 0.0))
+    s._setRigidPartMass(p, mass, inertia)
     return s, p, c
 
 
 def _one_step(s):
-    s.step()
-    f = s.contactNodeForces()
-    m = s.nodeState()[0]
+    s.run(1)
+    f = s._contactNodeForces()
+    m = s._nodeState()[0]
     on = np.any(f != 0, axis=1)                  # the contact nodes (f_nor ≠ 0)
     return s.time, f, m, on
 
@@ -56,7 +56,7 @@ def test_uniform_slip_is_removed_in_one_step_with_momentum_conserved(d):
     # every contact node gets the same share of its stick force, f_x = α m_i v0/Δt (Eq. 24 × α)
     assert np.allclose(f[on, 0] / m[on], alpha * v0 / dt, rtol=1e-12, atol=0)
     # analytic one-step balance: body v0 + Δt F/M, nodes α v0 -> no relative slip left, momentum conserved
-    F = np.asarray(s.rigidPartForce(p))
+    F = np.asarray(s._rigidPartForce(p))
     v_body = v0 + dt * F[0] / M
     assert v_body == pytest.approx(alpha * v0, rel=1e-12)
     pm = s.view("mass") @ s.view("v0")           # particles' momentum along x after the step
@@ -78,20 +78,20 @@ def test_box_sheared_between_two_slabs_stops_both_faces():
     s = ym.make_solver((0, 0), (0.4, 0.24), L)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, 0.0), (0.3, TOP))
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.1, TOP + 0.06), (0.3, TOP + 0.12))
-    p = s.addRigidPart()
-    g = s.addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
-    s.addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.2, 0.03 + 0.002))      # pressed 2 mm into both faces
-    s.setRigidPartState(p, (0.2, TOP + 0.03), np.eye(2), (0.0, 0.0), 0.0)
-    s.setRigidPartMass(p, M, inf)
+    p = s._addRigidPart()
+    g = s._addContactGroup([p], ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    s._addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.2, 0.03 + 0.002))      # pressed 2 mm into both faces
+    s._setRigidPartState(p, (0.2, TOP + 0.03), np.eye(2), (0.0, 0.0), 0.0)
+    s._setRigidPartMass(p, M, inf)
     s.view("v0")[:] = np.where(s.view("x1") > TOP + 0.03, v0, -v0)
-    s.step()
-    f, m = s.contactNodeForces(), s.nodeState()[0]
+    s.run(1)
+    f, m = s._contactNodeForces(), s._nodeState()[0]
     on = np.any(f != 0, axis=1)
-    y = s.nodePositions()[on][:, 1]
+    y = s._nodePositions()[on][:, 1]
     S = m[on].sum()
     assert np.any(y > TOP + 0.03) and np.any(y < TOP + 0.03) and S > 2 * M   # both faces, heavier than the box
     assert np.allclose(f[on, 0] / m[on], np.where(y > TOP + 0.03, -v0, v0) / s.time, rtol=1e-9, atol=0)
-    assert abs(s.rigidPartForce(p)[0]) < 1e-9 * S * v0 / s.time             # the box stays at rest
+    assert abs(s._rigidPartForce(p)[0]) < 1e-9 * S * v0 / s.time             # the box stays at rest
 
 
 def test_two_free_parts_of_one_group_each_take_their_own_response():
@@ -101,22 +101,22 @@ def test_two_free_parts_of_one_group_each_take_their_own_response():
     v0, Ms, inf = 0.1, (0.2, 3.0), float("inf")
     s = ym.make_solver((0, 0), (0.4, 0.2), L)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.0, 0.0), (0.4, TOP))
-    parts = [s.addRigidPart(), s.addRigidPart()]
-    g = s.addContactGroup(parts, ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
+    parts = [s._addRigidPart(), s._addRigidPart()]
+    g = s._addContactGroup(parts, ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))
     for k, p in enumerate(parts):
-        s.addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.09, 0.02))
-        s.setRigidPartState(p, (0.1 + 0.2 * k, TOP + 0.02 - 0.002), np.eye(2), (v0, 0.0), 0.0)
-        s.setRigidPartMass(p, Ms[k], inf)
+        s._addContactBox(g, p, (0.0, 0.0), np.eye(2), (0.09, 0.02))
+        s._setRigidPartState(p, (0.1 + 0.2 * k, TOP + 0.02 - 0.002), np.eye(2), (v0, 0.0), 0.0)
+        s._setRigidPartMass(p, Ms[k], inf)
     dt, f, m, on = _one_step(s)
-    x = s.nodePositions()
-    owner = np.array([s.contactQuery(g, tuple(xi))[2] for xi in x[on]])
+    x = s._nodePositions()
+    owner = np.array([s._contactQuery(g, tuple(xi))[2] for xi in x[on]])
     for k, p in enumerate(parts):
         mine = owner == p
         S = m[on][mine].sum()
         assert S > 0
         alpha = Ms[k] / (Ms[k] + S)
         assert np.allclose(f[on][mine, 0] / m[on][mine], alpha * v0 / dt, rtol=1e-12, atol=0)
-        assert s.rigidPartForce(p)[0] == pytest.approx(-alpha * S * v0 / dt, rel=1e-12)
+        assert s._rigidPartForce(p)[0] == pytest.approx(-alpha * S * v0 / dt, rel=1e-12)
 
 
 @pytest.mark.parametrize("d", [2, 3])
@@ -130,9 +130,9 @@ def test_free_rotation_every_node_sticks_to_the_body_in_one_step(d):
     I = 0.5 * M * 0.02 ** 2
     s, p, c = _box_sliding_on_slab(d, M, I if d == 2 else (I,) * 3)
     dt, f, m, on = _one_step(s)
-    r = s.nodePositions()[on] - c
+    r = s._nodePositions()[on] - c
     assert len(np.unique(np.round(r[:, 1], 9))) >= 2                # node rows at different lever arms
-    F, T = np.asarray(s.rigidPartForce(p)), np.atleast_1d(s.rigidPartTorque(p))
+    F, T = np.asarray(s._rigidPartForce(p)), np.atleast_1d(s._rigidPartTorque(p))
     v_body, w_body = np.eye(d)[0] * v0 + dt * F / M, dt * T / I
     if d == 2:
         body_at = v_body + w_body[0] * np.column_stack([-r[:, 1], r[:, 0]])
@@ -182,7 +182,7 @@ def _dragged_block(g_x, steps, rho_block=400.0):
                  NewtonIntegrator(damping=0.0, gravity=(g_x, -G_Y, 0)), PyRunner(command="_stick_test_record()", iterPeriod=1)]
     O.dt = 1.0
     O.run(steps, True)
-    f, mn = s.contactNodeForces(), s.nodeState()[0]
+    f, mn = s._contactNodeForces(), s._nodeState()[0]
     return np.array(rec), st.mass, m.sum(), mn[np.any(f != 0, axis=1)].sum()
 
 
@@ -241,35 +241,35 @@ def test_adapter_passes_mass_and_inertia_and_prescribed_bodies_are_immovable():
         rb.add(i)
     st = O.bodies[ids[0]].state
     part = {i: rb._part(i)[1] for i in ids}
-    m, I = s.rigidPartMass(part[ids[0]])
+    m, I = s._rigidPartMass(part[ids[0]])
     assert m == pytest.approx(st.mass / t, rel=1e-15) and I == pytest.approx(st.inertia[2] / t, rel=1e-15)
-    assert s.rigidPartMass(part[ids[1]])[0] == float("inf") and np.isfinite(s.rigidPartMass(part[ids[1]])[1])
-    assert np.isfinite(s.rigidPartMass(part[ids[2]])[0]) and s.rigidPartMass(part[ids[2]])[1] == float("inf")
-    assert s.rigidPartMass(part[ids[3]]) == (float("inf"), float("inf"))
+    assert s._rigidPartMass(part[ids[1]])[0] == float("inf") and np.isfinite(s._rigidPartMass(part[ids[1]])[1])
+    assert np.isfinite(s._rigidPartMass(part[ids[2]])[0]) and s._rigidPartMass(part[ids[2]])[1] == float("inf")
+    assert s._rigidPartMass(part[ids[3]]) == (float("inf"), float("inf"))
     st.mass = 2.0                                 # read every step
     rb.read()
-    assert s.rigidPartMass(part[ids[0]])[0] == pytest.approx(2.0 / t)
+    assert s._rigidPartMass(part[ids[0]])[0] == pytest.approx(2.0 / t)
     s3 = ym.make_solver((0, 0, 0), (0.4, 0.3, 0.3), 0.05)
     ym.add_region(s3, ym.ElasticMat(**SLAB), (0.1, 0.0, 0.1), (0.3, 0.1, 0.2))
     b3 = O.bodies.append(utils.box((0.2, 0.2, 0.15), (0.05, 0.01, 0.03)))
     rb3 = ym.RigidBodies(s3)
     rb3.add(b3)
-    m3, I3 = s3.rigidPartMass(rb3._part(b3)[1])
+    m3, I3 = s3._rigidPartMass(rb3._part(b3)[1])
     assert m3 == pytest.approx(O.bodies[b3].state.mass) and I3 == pytest.approx(tuple(O.bodies[b3].state.inertia))
 
 
 def test_bad_mass_input_is_refused_naming_it():
     s = ym.make_solver((0, 0), (0.4, 0.3), L)
-    p = s.addRigidPart()
+    p = s._addRigidPart()
     for bad in (0.0, -1.0, float("nan"), "1", True):
         with pytest.raises(ValueError, match="mass"):
-            s.setRigidPartMass(p, bad, 1.0)
+            s._setRigidPartMass(p, bad, 1.0)
         with pytest.raises(ValueError, match="inertia"):
-            s.setRigidPartMass(p, 1.0, bad)
-    assert s.rigidPartMass(p) == (float("inf"), float("inf"))          # nothing changed
-    q = s.addRigidPart()
+            s._setRigidPartMass(p, 1.0, bad)
+    assert s._rigidPartMass(p) == (float("inf"), float("inf"))          # nothing changed
+    q = s._addRigidPart()
     with pytest.raises(ValueError, match="mass"):
-        s.setRigidPartMasses([p, q], [1.0, -1.0], [[1.0], [1.0]])
-    assert s.rigidPartMass(p) == (float("inf"), float("inf"))          # checked before any change
-    s.setRigidPartMass(p, 3.0, float("inf"))                           # inf: that motion prescribed
-    assert s.rigidPartMass(p) == (3.0, float("inf"))
+        s._setRigidPartMasses([p, q], [1.0, -1.0], [[1.0], [1.0]])
+    assert s._rigidPartMass(p) == (float("inf"), float("inf"))          # checked before any change
+    s._setRigidPartMass(p, 3.0, float("inf"))                           # inf: that motion prescribed
+    assert s._rigidPartMass(p) == (3.0, float("inf"))

@@ -101,8 +101,8 @@ def test_bad_contact_input_is_refused_naming_it():
     with pytest.raises(ValueError, match="does not cross the plane z = 0"):
         rb.add(far)
     with pytest.raises(ValueError, match="chi"):
-        s.addContactGroup([s.addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=1.0, d0=None))
-    assert not s.contactActive                       # nothing was registered by the refused calls
+        s._addContactGroup([s._addRigidPart()], ym.bodies.contact_params(mu=0.0, cohesion=0.0, chi=1.0, d0=None))
+    assert not s._contactActive                       # nothing was registered by the refused calls
 
 
 def test_uniaxial_builder_places_platen_and_filler():
@@ -119,12 +119,12 @@ def test_uniaxial_builder_places_platen_and_filler():
     assert filler.state.blockedDOFs == "zXY"
     c = sc["flaw"]["center"]
     assert np.hypot(filler.state.pos[0] - c[0], filler.state.pos[1] - c[1]) < 1e-12
-    d, n, part = s.contactQuery(1, tuple(c))       # group 1: the filler
+    d, n, part = s._contactQuery(1, tuple(c))       # group 1: the filler
     assert d < 0
     O.step()
-    ex = s.excludedNodes()
-    X = s.nodePositions()
-    inside = np.array([s.contactQuery(1, tuple(x))[0] < 0 for x in X[np.abs(X[:, 1] - c[1]) < 0.01]])
+    ex = s._excludedNodes()
+    X = s._nodePositions()
+    inside = np.array([s._contactQuery(1, tuple(x))[0] < 0 for x in X[np.abs(X[:, 1] - c[1]) < 0.01]])
     assert np.all(ex[np.abs(X[:, 1] - c[1]) < 0.01][inside] & ym._core.exclusionBits["contact"])
     top = ym.get(s, "pos")[:, 1].max()
     # d0 = half the particle edge; the kinematic law moves the touching top row with the platen from the first step

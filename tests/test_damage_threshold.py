@@ -51,7 +51,7 @@ def test_default_threshold_volume_is_the_particle_volume(dim):
     DP–GK model (Graphyt: vol = mass/density, emin = pow(vol·k, −1/m); 2D volume psep² per unit depth).
     V is taken here from each particle's mass and the rock density, not from the solver's volume arrays."""
     s, dp = block(0.04, size=0.16, dim=dim)
-    assert s.dpgkParameters().thresholdVolume == "particle"
+    assert s.material(0).thresholdVolume == "particle"
     V = s.view("mass") / rocks.GRANITE["density"]                    # [m³]; 2D: area × 1 m
     assert V == pytest.approx(np.full(s.numParticles, dp ** dim), rel=1e-12)
     assert s.view("eps0") == pytest.approx((V * K) ** (-1.0 / M_W), rel=1e-12)

@@ -36,9 +36,9 @@ s.addBoundaryPlane(0, -1, 0.0, "slip")
 s.damping = 0.05
 s.sortPeriod = 7
 # an excluded node in the interior (as rigid-body contact will do): general stencils around it
-pos = s.nodePositions()
+pos = s._nodePositions()
 target = 0.4 * np.array(hi)
-s.setNodeExcluded(int(np.argmin(np.sum((pos - target) ** 2, axis=1))), True)
+s._setNodeExcluded(int(np.argmin(np.sum((pos - target) ** 2, axis=1))), True)
 # pure-shear initial velocity: stress to yield and damage within the run, drift across blocks
 x = [s.view(f"x{a}") for a in range(dim)]
 s.view("v0")[:] = 60.0 * (x[0] - 0.5 * hi[0])
@@ -50,7 +50,7 @@ s.run(nsteps)
 out = {}
 for name, arr in views(s).items():
     out[name] = np.asarray(arr).tobytes().hex()
-out["eff"] = s.effectiveStress().tobytes().hex()
+out["eff"] = s._effectiveStress().tobytes().hex()
 out["time"] = s.time.hex()
 out["damaged"] = float(np.mean(s.view("damage") > 0))
 out["plastic"] = float(np.mean(s.view("epsP") > 0))

@@ -85,7 +85,7 @@ def test_particle_fields_export_damage_state():
     s = ym.make_solver((0, 0), (0.2, 0.2), 0.05)
     ym.add_region(s, mat(), (0, 0), (0.2, 0.2))
     ym.set_initial_stress(s, (-40e6, 60e6, 0.0, 0.0))   # beyond both criteria: yields and damages
-    s.step()
+    s.run(1)
     _, f = out.particle_fields(s)
     for k in ("damage", "plastic_strain", "cohesion", "max_principal_stress", "tensile_crack", "shear_crack"):
         assert k in f and len(f[k]) == s.numParticles

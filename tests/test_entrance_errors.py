@@ -31,7 +31,7 @@ def test_id_view_is_read_only():
         with pytest.raises(ValueError, match="read-only"):
             v[:] = 0                                     # duplicates would silently scramble every id-ordered field
     assert sorted(ym.get(s, "id")) == list(range(s.numParticles))
-    s.step()                                            # the views still follow the solver's arrays
+    s.run(1)                                            # the views still follow the solver's arrays
     assert sorted(s.view("id")) == list(range(s.numParticles))
 
 

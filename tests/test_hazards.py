@@ -24,17 +24,17 @@ def test_second_add_particles_refused_while_views_alive_unless_reserved():
     s = _scene()
     v = s.view("x0")
     with pytest.raises(ValueError, match=r"addParticles: 1 NumPy view\(s\) .* would move the arrays"):
-        s.addParticles(*_more(s))
+        s._addParticles(*_more(s))
     n = s.numParticles
     assert s.numParticles == n and v[0] == s.view("x0")[0]
     del v                                             # no view left: the arrays may move
-    s.addParticles(*_more(s))
+    s._addParticles(*_more(s))
     assert s.numParticles == n + 2
     # reserve first: views taken afterwards stay on the same memory while adding
     s.reserve(n + 10)
     v = s.view("x1")
     before = v.__array_interface__["data"][0]
-    s.addParticles(*_more(s))
+    s._addParticles(*_more(s))
     assert s.view("x1").__array_interface__["data"][0] == before
     assert np.array_equal(v, s.view("x1")[:len(v)])
 
@@ -46,23 +46,23 @@ def test_clock_and_energy_only_through_checked_setters():
             setattr(s, name, bad)
     assert (s.time, s.steps, s.externalWork) == (0.0, 0, 0.0)
     s.tractionRampTime = 1.0
-    assert s.loadScale(s.time) == 0.0                 # time = -1 used to give a ramp factor of −1 (reversed load)
+    assert s._loadScale(s.time) == 0.0                 # time = -1 used to give a ramp factor of −1 (reversed load)
     s.steps, s.time, s.externalWork = 7, 0.5, 2.0     # a resumed run sets its clock
-    s.step()
+    s.run(1)
     assert s.steps == 8 and s.time == pytest.approx(0.5 + s.lastDt, rel=1e-15)
 
 
 def test_position_moved_past_block_reach_without_request_sort():
     s = _scene(hi=(0.8, 0.4))
-    s.step()                                          # sorted into blocks of 8 cells
+    s.run(1)                                          # sorted into blocks of 8 cells
     x0 = s.view("x0")
     p = int(np.argmin(x0))                            # a particle of the leftmost blocks
     pid = int(s.view("id")[p])
     x0[p] = 0.7                                       # 35 cells to the right, still on the grid
     with pytest.raises(ym.MpmSimulationError, match=f"particle id {pid} at .* beyond the cells its block may reach .*requestSort"):
-        s.step()
+        s.run(1)
     s.requestSort()                                   # the documented way: re-sort, then step
-    s.step()
+    s.run(1)
     assert s.steps == 2
 
 
@@ -71,33 +71,33 @@ def test_position_written_through_a_view_already_deleted_is_still_checked():
     step (a step without views pays nothing): a view deleted before the step still counts, and a refused
     step does not clear that."""
     s = _scene(hi=(0.8, 0.4))
-    s.step()
+    s.run(1)
     p = int(np.argmin(s.view("x0")))
     pid = int(s.view("id")[p])
     s.view("x0")[p] = 0.7                             # a temporary view: gone before the step
     for _ in range(2):                                # refused again: the particle is still out of reach
         with pytest.raises(ym.MpmSimulationError, match=f"particle id {pid} at .* beyond the cells its block may reach"):
-            s.step()
+            s.run(1)
     assert s.steps == 1
     s.requestSort()
-    s.step()
-    s.step()                                          # no view since the last step: the plain P2G
+    s.run(1)
+    s.run(1)                                          # no view since the last step: the plain P2G
     assert s.steps == 3
 
 
 def test_bad_mass_through_a_view_names_particle_and_quantity():
     s = _scene()
-    s.step()
+    s.run(1)
     p = 17
     pid = int(s.view("id")[p])
     s.view("mass")[p] = -1.0
     with pytest.raises(ym.MpmSimulationError, match=f"in P2G: particle id {pid} has mass m = -1 kg"):
-        s.step()                                      # was reported as another particle's "non-finite stress"
+        s.run(1)                                      # was reported as another particle's "non-finite stress"
     s.requestSort()
     with pytest.raises(ValueError, match=f"mass of particle id {pid} = -1 kg must be finite and > 0"):
-        s.step()
+        s.run(1)
     s.view("mass")[p] = s.view("mass")[p + 1]         # the particles were untouched: fixing the mass is enough
-    s.step()
+    s.run(1)
 
 
 def test_max_speed_refreshed_when_velocities_lowered_through_views():
@@ -121,7 +121,7 @@ def test_failed_step_with_particles_partly_updated_refuses_to_continue():
         s.run(10)
     steps, t = s.steps, s.time                        # the clock did not advance, the particles partly did
     with pytest.raises(ym.MpmSimulationError, match="cannot step: the last step failed .*restore a checkpoint"):
-        s.step()
+        s.run(1)
     assert (s.steps, s.time) == (steps, t)
 
 
@@ -142,4 +142,4 @@ def test_solver_settings_declared_once_with_unit_range_and_doc():
             setattr(s, name, bad)
     s.autoDt = False                                  # fixedDt left at 0 (not set): refused, not a 0-length step
     with pytest.raises(ValueError, match="fixedDt = 0 s is not set"):
-        s.step()
+        s.run(1)

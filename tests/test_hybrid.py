@@ -200,7 +200,7 @@ def test_far_spheres_are_skipped_and_change_nothing():
     _run(a, sp)
     O.run(400, True)
     for _ in range(400):
-        b.step()
+        b.run(1)
     assert not sp.active.any()
     assert sp.checks <= 3
     for name in ("pos", "vel", "stress"):

@@ -123,3 +123,46 @@ def test_no_contact_header_includes_an_mpi_header():
             if re.search(r'#\s*include\s*[<"](mpi\.h|mpi/|Mpi|ContactMpi|HaloExchange|Decomposition)', line) or "MPI_" in line:
                 bad.append(f"{os.path.relpath(path, ROOT)}:{k}: {line.strip()}")
     assert not bad, "\n".join(bad)
+
+
+def _documented_solver_members():
+    api = open(os.path.join(ROOT, "doc", "guide", "api.md")).read()
+    section = api.split("## The solver's members", 1)[1].split("\n## ", 1)[0]
+    return [m.group(1) for m in re.finditer(r"^\| `(\w+)", section, re.M)]
+
+
+def test_solver_public_members_are_the_documented_list():
+    """One obvious way: the solver's public members (no leading underscore) are exactly the documented table of
+    doc/guide/api.md, one line each; the rest is the adapters' plumbing (leading underscore)."""
+    import yade_mpm as ym
+    doc = _documented_solver_members()
+    assert len(doc) == len(set(doc)), sorted(n for n in doc if doc.count(n) > 1)
+    mpi_only = {"mpiInfo"}
+    for cls in (ym.Solver2D, ym.Solver3D):
+        public = {n for n in dir(cls) if not n.startswith("_")}
+        assert public - set(doc) == set(), f"{cls.__name__}: public members without their line in doc/guide/api.md"
+        assert set(doc) - public - mpi_only == set(), f"{cls.__name__}: documented members that do not exist"
+        assert "step" not in public and "advance" not in public
+    assert len(doc) <= 36, len(doc)
+
+
+def test_compiled_modules_live_in_the_build_folder_out_of_the_source_tree():
+    from yade_mpm import _build
+    import yade_mpm as ym
+    assert os.path.dirname(os.path.abspath(ym._core.__file__)) == _build.module_dir()
+    assert not glob.glob(os.path.join(PY, "yade_mpm", "_core*.so")), "a stale module in the package folder (run ./setup.sh)"
+
+
+def test_build_folder_override_and_a_clear_error_without_a_build(tmp_path):
+    import subprocess
+    import sys
+    from yade_mpm import _build
+    code = "import yade_mpm, os; print(os.path.dirname(yade_mpm._core.__file__))"
+    base = dict(os.environ, PYTHONPATH=PY, OMP_NUM_THREADS="1")
+    ok = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                        env=dict(base, YADE_MPM_BUILD_DIR=_build.build_dir()))
+    assert ok.returncode == 0 and ok.stdout.strip() == _build.module_dir(), ok.stderr
+    bad = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                         env=dict(base, YADE_MPM_BUILD_DIR=str(tmp_path)))
+    assert bad.returncode != 0
+    assert "ImportError" in bad.stderr and "YADE_MPM_BUILD_DIR" in bad.stderr and str(tmp_path) in bad.stderr, bad.stderr

@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import pytest
 from helpers import script_path
+from yade_mpm import _build   # where the compiled modules are (build/py/yade_mpm)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LAUNCH = script_path("mpi_run.sh")
@@ -68,7 +69,7 @@ FIELDS3 = ["x0", "x1", "x2", "v0", "v1", "v2", "sig0", "sig1", "sig2", "sig3", "
 
 def _mpi_expected():
     """True when the build found MPI (CMake writes build/mpi_expected): then the MPI tests must run."""
-    path = os.path.join(ROOT, "build", "mpi_expected")
+    path = os.path.join(_build.build_dir(), "mpi_expected")
     return os.path.exists(path) and open(path).read().strip() == "ON"
 
 
@@ -78,8 +79,8 @@ def _mpi_available():
     reason = None
     if shutil.which("mpirun") is None:
         reason = "mpirun is missing (Debian: apt-get install openmpi-bin libopenmpi-dev)"
-    elif not glob.glob(os.path.join(ROOT, "py", "yade_mpm", "_core_mpi*.so")):
-        reason = "the MPI core py/yade_mpm/_core_mpi*.so is not built (libopenmpi-dev missing when cmake ran)"
+    elif not glob.glob(os.path.join(_build.module_dir(), "_core_mpi*.so")):
+        reason = f"the MPI core {_build.module_dir()}/_core_mpi*.so is not built (libopenmpi-dev missing when cmake ran)"
     if reason and _mpi_expected():
         pytest.fail(f"setup found MPI (build/mpi_expected = ON) but {reason}", pytrace=False)
     return reason
@@ -198,7 +199,7 @@ v = s.view("v1")
 expect("stepping with a live view", lambda: s.run(1), "view(s) of the particle arrays are alive")
 del v
 s.run(3)
-expect("addParticles after the split", lambda: s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.2])), "after the first step")
+expect("addParticles after the split", lambda: s._addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.2])), "after the first step")
 expect("checkpoint saving before the first step", lambda: ym.checkpoint.save("/nonexistent/ck", s1), "save after the first step")
 if rank == 1:   # a bad value on one rank only: every rank stops with a ValueError (none waits forever)
     v = s.view("v0"); v[0] = np.nan; del v

@@ -109,7 +109,7 @@ except ValueError as e:
     msg = str(e)
 box2 = O.bodies.append(utils.box((0.1, 0.29, 0), (0.1, 0.01, 0.5), fixed=True))
 rb.add(box2, mu=0.3, law="penalty")             # the named option runs
-np.savez(f"{out}.{ym.parallel.rank()}.npz", msg=msg, active=s.contactActive, groups=s.numContactGroups)
+np.savez(f"{out}.{ym.parallel.rank()}.npz", msg=msg, active=s._contactActive, groups=s._numContactGroups)
 """
 
 

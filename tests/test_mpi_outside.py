@@ -21,12 +21,12 @@ s.requestSort()
 s.autoDt, s.fixedDt = False, 0.999 * s.courant * s.spacing / (s.waveSpeed() + 200.0)
 s.sortPeriod = 10
 s.run(steps)
-acc = s.removedAccount()                      # a collective under MPI: over every rank
+acc = s._removedAccount()                      # a collective under MPI: over every rank
 rank = s.mpiInfo()["rank"] if hasattr(s, "mpiInfo") else 0
 res = {n: np.array(s.view(n)) for n in ("x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol", "id")}
 res["acc"] = np.array([acc["count"], acc["mass"], acc["kinetic_energy"], *acc["momentum"], acc["faces"]["x+"]])
-res["removed_ids"] = np.array(s.removedParticles()["id"])
-res["reason"] = np.array(s.removedParticles()["reason"])
+res["removed_ids"] = np.array(s._removedParticles()["id"])
+res["reason"] = np.array(s._removedParticles()["reason"])
 np.savez(f"{out}.{rank}.npz", **res)
 """
 

@@ -46,7 +46,7 @@ def test_layered_bar_transmitted_stress_and_arrival_time():
     t, sig = [], []
     # until the reflection from the free far end returns to the station (L1/c1 + 3·(L2 − 0.4)... > 1.38 ms)
     while s.time < 1.3e-3:
-        s.step()
+        s.run(1)
         t.append(s.time)
         sig.append(-ym.get(s, "stress")[station, 0].mean() / P)
     t, sig = np.array(t), np.array(sig)
@@ -77,7 +77,7 @@ def test_regions_keep_their_own_material_and_damage_thresholds():
     eps0_before = s.view("eps0")[np.argsort(s.view("id"))].copy()
     ids_grout = ym.add_region(s, GROUT, (0.2, 0), (0.4, 0.1))
     mat = ym.get(s, "material")
-    assert s.numMaterials == 2 and list(s.materialKinds) == [1, 0]
+    assert s.numMaterials == 2 and list(s._materialKinds) == [1, 0]
     assert np.all(mat[ids_rock] == 0) and np.all(mat[ids_grout] == 1)
     # the rock keeps its parameters and its particles their Eq. 37 thresholds ε_D⁰ = (V k)^(−1/m)
     assert s.material(0).toDict() == rock.toDict()
@@ -94,9 +94,9 @@ def test_regions_keep_their_own_material_and_damage_thresholds():
     assert np.all(c[ids_rock] == rock.cohesion) and np.all(np.isnan(c[ids_grout]))
     # setMaterial would replace one of two materials: refused
     with pytest.raises(ValueError, match="setMaterial: this solver holds 2 materials"):
-        s.setMaterial(GROUT)
+        s._setMaterial(GROUT)
     with pytest.raises(ValueError, match="material"):
-        s.addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.25]), material=2)
+        s._addParticles(np.array([[0.05, 0.05]]), np.array([1e-4]), np.array([0.25]), material=2)
 
 
 def test_material_view_is_read_only_and_set_particle_material_gives_the_new_threshold():
@@ -118,7 +118,7 @@ def test_material_view_is_read_only_and_set_particle_material_gives_the_new_thre
     assert np.allclose(s.view("eps0")[g], (v * rock.weibullK) ** (-1 / rock.weibullM), rtol=1e-12)
     s.setParticleMaterial(r, 1)                            # rock → grout: no damage threshold
     assert np.all(s.view("material")[r] == 1) and np.all(s.view("eps0")[r] == 0)
-    weak = s.addMaterial(rocks.granite_dpgk(weibullK=1.0))  # V·k < 1: ε_D⁰ > 1, damage could never start
+    weak = s._addMaterial(rocks.granite_dpgk(weibullK=1.0))  # V·k < 1: ε_D⁰ > 1, damage could never start
     before = (s.view("material").copy(), s.view("eps0").copy())
     for args, msg in (((r, weak), r"damage threshold eps0 .* outside the allowed range \(0, 1\)"),
                       ((r, 3), r"material = 3 is not a material index of this solver: allowed range \[0, 2\]"),
@@ -128,7 +128,7 @@ def test_material_view_is_read_only_and_set_particle_material_gives_the_new_thre
         with pytest.raises(ValueError, match=msg):
             s.setParticleMaterial(*args)
     assert np.array_equal(s.view("material"), before[0]) and np.array_equal(s.view("eps0"), before[1])
-    s.step()
+    s.run(1)
 
 
 def test_one_material_scene_runs_the_single_material_path():
@@ -137,6 +137,6 @@ def test_one_material_scene_runs_the_single_material_path():
     ym.add_region(s, GROUT, (0, 0), (0.2, 0.1))
     ym.add_region(s, GROUT, (0, 0.1), (0.2, 0.2))
     assert s.numMaterials == 1 and np.all(s.view("material") == 0)
-    s.setMaterial(ROCK)                                     # old scripts: replaces the only material
+    s._setMaterial(ROCK)                                     # old scripts: replaces the only material
     assert s.material(0).toDict() == ROCK.toDict()
     assert s.waveSpeed() == pytest.approx(np.sqrt(p_modulus(ROCK) / GROUT.density), rel=1e-12)

@@ -75,7 +75,7 @@ def test_intact_body_pushed_off_the_grid_stops_with_particle_face_and_position()
     assert "left the grid along axis 0 through its x+ face" in msg and "intact material of the body" in msg
     x = ym.get(s, "pos")[pid]
     assert f"position ({x[0]:.6g}, {x[1]:.6g}) m" in msg
-    assert s.removedAccount()["count"] == 0
+    assert s._removedAccount()["count"] == 0
 
 
 def test_outside_policies_stop_and_remove():
@@ -88,7 +88,7 @@ def test_outside_policies_stop_and_remove():
     s.outside = "remove"
     n = s.numParticles
     s.run(400)
-    acc = s.removedAccount()
+    acc = s._removedAccount()
     assert acc["count"] > 0 and s.numParticles == n - acc["count"] and acc["faces"]["x+"] == acc["count"]
     with pytest.raises(ValueError, match="outside must be one of 'stop', 'remove' or 'remove-debris'"):
         s.outside = "ignore"
@@ -114,7 +114,7 @@ def test_vtu_leaves_removed_particles_out(tmp_path):
 
 def _all_bits(s):
     f = ym.fields(s)
-    return {k: np.asarray(v).tobytes() for k, v in f.items()} | {"acc": repr(s.removedAccount())}
+    return {k: np.asarray(v).tobytes() for k, v in f.items()} | {"acc": repr(s._removedAccount())}
 
 
 def test_one_and_two_threads_give_the_same_bits_with_a_removal():
@@ -133,15 +133,15 @@ def test_checkpoint_after_a_removal_resumes_bit_identical(tmp_path):
         s.autoDt, s.fixedDt = False, _fixed_dt(s)
         return s
     s = build()
-    while s.removedAccount()["count"] in (0, 16):                  # part of the fragment removed, part not
+    while s._removedAccount()["count"] in (0, 16):                  # part of the fragment removed, part not
         s.run(20)
         assert s.steps < 5000
-    k = s.removedAccount()["count"]
+    k = s._removedAccount()["count"]
     path = str(tmp_path / "run.ckpt")
     ym.checkpoint.save(path, s, yade=False)
     s.run(300)
     r = build()
     ym.checkpoint.load(path, r, yade=False)
-    assert r.removedAccount()["count"] == k and r.numParticles == s.numParticles + s.removedAccount()["count"] - k
+    assert r._removedAccount()["count"] == k and r.numParticles == s.numParticles + s._removedAccount()["count"] - k
     r.run(300)
     assert _all_bits(r) == _all_bits(s)

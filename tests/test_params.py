@@ -69,8 +69,8 @@ def test_round_trip_and_alias():
     assert ym.DpGkMat.fromDict(json.loads(json.dumps(de))).toDict() == de
     # solver hands back the material it was given
     s = ym.Solver2D((0, 0), 0.1, (4, 4))
-    s.setMaterial(m)
-    assert s.dpgkParameters().toDict() == d
+    s._setMaterial(m)
+    assert s.material(0).toDict() == d
 
 
 @pytest.mark.parametrize("name, value, msg", [

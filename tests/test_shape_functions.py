@@ -6,8 +6,8 @@ import yade_mpm as ym
 
 
 def _check(s, point, expect_general):
-    idx, psi, grad, general = s.shapeFunctions(point)
-    xi = s.nodePositions()[idx]
+    idx, psi, grad, general = s._shapeFunctions(point)
+    xi = s._nodePositions()[idx]
     assert general == expect_general
     assert abs(psi.sum() - 1) < 1e-12                           # Σ ψ_i = 1
     np.testing.assert_allclose(psi @ xi, point, atol=1e-12)     # Σ ψ_i x_i = x_p
@@ -24,7 +24,7 @@ def test_interior_is_cubic_bspline(dim):
     for _ in range(20):
         p = 0.3 + 0.4 * rng.random(dim)
         idx, psi, grad = _check(s, p, expect_general=False)
-        xi = s.nodePositions()[idx]
+        xi = s._nodePositions()[idx]
 
         def w1(t):
             t = abs(t)
@@ -42,7 +42,7 @@ def test_grid_edge_and_corner(dim):
         idx, psi, _ = _check(s, p, expect_general=True)
         # ghost nodes (outside the grid) carry nothing
         lo, hi = -1e-12, 1 + 1e-12
-        xi = s.nodePositions()[idx]
+        xi = s._nodePositions()[idx]
         outside = np.any((xi < lo) | (xi > hi), axis=1)
         assert outside.any() and np.all(psi[outside] == 0)
 
@@ -52,7 +52,7 @@ def test_excluded_nodes():
     p = np.array([0.43, 0.57])
     idx, psi0, _ = _check(s, p, expect_general=False)
     for k in [0, 5, 6, 15]:                  # corner, two inner, far corner of the stencil
-        s.setNodeExcluded(int(idx[k]), True)
+        s._setNodeExcluded(int(idx[k]), True)
     _, psi, _ = _check(s, p, expect_general=True)
     assert np.all(psi[[0, 5, 6, 15]] == 0)
     assert not np.allclose(psi, psi0)

@@ -71,9 +71,9 @@ def test_changing_the_count_between_steps_changes_no_bit():
     try:
         for k in range(60):
             ym.setThreads(2)
-            a.step()
+            a.run(1)
             ym.setThreads(1 + k % 2)                                  # b alternates 1, 2, 1, ...
-            b.step()
+            b.run(1)
     finally:
         ym.setThreads(threads.available_cores())
     for f in ("pos", "vel", "stress", "damage", "plastic_strain"):

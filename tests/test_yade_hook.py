@@ -32,7 +32,7 @@ def test_o_run_matches_direct_stepping():
     O.dt = 1.0                                    # far above the MPM stable step: must be lowered
     O.run(150, True)
     for _ in range(150):
-        b.step()
+        b.run(1)
     assert O.iter == a.steps == 150
     assert O.time == pytest.approx(a.time, rel=1e-12)
     assert O.dt == a.lastDt < 1e-3                 # lowered to the MPM step used last

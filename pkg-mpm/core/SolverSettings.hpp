@@ -31,7 +31,7 @@ MPM_CHOICES(OutsidePolicy, "stop|remove|remove-debris")
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
 	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
 	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \
-	  "removed particles are accounted in Solver.removedAccount()", "", "")
+	  "removed particles are accounted in yade_mpm.removed(solver)", "", "")
 
 #define MPM_SOLVER_PARAMS(X) MPM_SOLVER_SETTINGS(X) MPM_SOLVER_STATE(X)
 

@@ -229,42 +229,42 @@ struct ContactWrap {
 
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
-		cls.def("addRigidPart", &addRigidPart, "new rigid part (one YADE body or clump); returns its index")
-		        .def("addContactGroup", &addContactGroup, (bp::arg("parts"), bp::arg("params")),
+		cls.def("_addRigidPart", &addRigidPart, "new rigid part (one YADE body or clump); returns its index")
+		        .def("_addContactGroup", &addContactGroup, (bp::arg("parts"), bp::arg("params")),
 		             "contact group over rigid parts with a ContactParams (μ, c, χ, d0, autoD0, initialD0; d0 at most one grid "
 		             "spacing); returns its index. With initialD0, call captureContactD0 at registration")
-		        .def("contactParams", &contactParams, bp::arg("group"), "copy of the ContactParams of a contact group")
-		        .add_property("numContactGroups", &numContactGroups, "number of contact groups")
-		        .def("captureContactD0", &captureContactD0, (bp::arg("group")),
+		        .def("_contactParams", &contactParams, bp::arg("group"), "copy of the ContactParams of a contact group")
+		        .add_property("_numContactGroups", &numContactGroups, "number of contact groups")
+		        .def("_captureContactD0", &captureContactD0, (bp::arg("group")),
 		             "d0 = 'initial': d0_p := initial distance of the first particle layer next to the group at its current pose")
-		        .def("removeLastContactGroup", &removeLastContactGroup,
+		        .def("_removeLastContactGroup", &removeLastContactGroup,
 		             "undo the last addContactGroup and its rigid parts (a registration refused half-way)")
-		        .def("contactInitialD0", &contactInitialD0, (bp::arg("group")),
+		        .def("_contactInitialD0", &contactInitialD0, (bp::arg("group")),
 		             "captured d0 [m] per particle id (NaN = default half edge); empty unless d0 = 'initial'")
-		        .def("addContactBox", &addContactBox, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("rotation"), bp::arg("half")))
-		        .def("addContactPlane", &addContactPlane, (bp::arg("group"), bp::arg("part"), bp::arg("point"), bp::arg("normal"), bp::arg("twoSided")))
-		        .def("addContactElement", &addContactElement, (bp::arg("group"), bp::arg("part"), bp::arg("vertices")))
-		        .def("setRigidPartState", &setRigidPartState, (bp::arg("part"), bp::arg("pos"), bp::arg("rot"), bp::arg("vel"), bp::arg("angVel")))
-		        .def("addContactSphere", &addContactSphere, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("radius")),
+		        .def("_addContactBox", &addContactBox, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("rotation"), bp::arg("half")))
+		        .def("_addContactPlane", &addContactPlane, (bp::arg("group"), bp::arg("part"), bp::arg("point"), bp::arg("normal"), bp::arg("twoSided")))
+		        .def("_addContactElement", &addContactElement, (bp::arg("group"), bp::arg("part"), bp::arg("vertices")))
+		        .def("_setRigidPartState", &setRigidPartState, (bp::arg("part"), bp::arg("pos"), bp::arg("rot"), bp::arg("vel"), bp::arg("angVel")))
+		        .def("_addContactSphere", &addContactSphere, (bp::arg("group"), bp::arg("part"), bp::arg("centre"), bp::arg("radius")),
 		             "sphere (3D) / circle (2D) of radius [m] at centre (part frame) in a contact group")
-		        .def("setContactGroupsEnabled", &setContactGroupsEnabled, (bp::arg("groups"), bp::arg("enabled")),
+		        .def("_setContactGroupsEnabled", &setContactGroupsEnabled, (bp::arg("groups"), bp::arg("enabled")),
 		             "switch contact groups on/off (off: skipped entirely)")
-		        .def("setRigidPartMotions", &setRigidPartMotions, (bp::arg("parts"), bp::arg("pos"), bp::arg("vel"), bp::arg("angVel")),
+		        .def("_setRigidPartMotions", &setRigidPartMotions, (bp::arg("parts"), bp::arg("pos"), bp::arg("vel"), bp::arg("angVel")),
 		             "positions, velocities, angular velocities of many parts (orientation unchanged)")
-		        .def("setRigidPartMass", &setRigidPartMass, (bp::arg("part"), bp::arg("mass"), bp::arg("inertia")),
+		        .def("_setRigidPartMass", &setRigidPartMass, (bp::arg("part"), bp::arg("mass"), bp::arg("inertia")),
 		             "mass [kg] (2D: kg/m) and principal moments of inertia about the centre along the part's axes [kg m^2] (2D: I_z, "
 		             "kg m^2/m) of a part, each in (0, inf]; inf (the default) = immovable along it (the paper's stick step). For a free "
 		             "part every contact node sticks to the part's motion after the step, from its momentum balance (doc/reference/contact.md)")
-		        .def("rigidPartMass", &rigidPartMass, bp::arg("part"), "(mass, inertia) of a part as set by setRigidPartMass")
-		        .def("setRigidPartMasses", &setRigidPartMasses, (bp::arg("parts"), bp::arg("mass"), bp::arg("inertia")),
+		        .def("_rigidPartMass", &rigidPartMass, bp::arg("part"), "(mass, inertia) of a part as set by setRigidPartMass")
+		        .def("_setRigidPartMasses", &setRigidPartMasses, (bp::arg("parts"), bp::arg("mass"), bp::arg("inertia")),
 		             "masses (n,) and principal moments of inertia (n, 1|3) of many parts, as setRigidPartMass")
-		        .def("rigidPartReactions", &rigidPartReactions, bp::arg("parts"), "(forces (n, D), torques (n, 1|3)) of parts")
-		        .def("rigidPartForce", &rigidPartForce, bp::arg("part"))
-		        .def("rigidPartTorque", &rigidPartTorque, bp::arg("part"))
-		        .def("contactQuery", &contactQuery, (bp::arg("group"), bp::arg("point")))
-		        .def("contactGroupClosed", &contactGroupClosed, bp::arg("group"))
-		        .def("contactNodeForces", &contactNodeForces)
-		        .add_property("contactActive", &contactActive);
+		        .def("_rigidPartReactions", &rigidPartReactions, bp::arg("parts"), "(forces (n, D), torques (n, 1|3)) of parts")
+		        .def("_rigidPartForce", &rigidPartForce, bp::arg("part"))
+		        .def("_rigidPartTorque", &rigidPartTorque, bp::arg("part"))
+		        .def("_contactQuery", &contactQuery, (bp::arg("group"), bp::arg("point")))
+		        .def("_contactGroupClosed", &contactGroupClosed, bp::arg("group"))
+		        .def("_contactNodeForces", &contactNodeForces)
+		        .add_property("_contactActive", &contactActive);
 	}
 };
 } // namespace

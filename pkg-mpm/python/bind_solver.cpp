@@ -56,7 +56,7 @@ struct SolverWrap {
 	}
 	static size_t materialIndex(S& s, bp::object i, const char* what)
 	{
-		if (s.materialSet().size() == 0) throw InputError(who(what) + ": this solver has no material yet (setMaterial or addMaterial first)");
+		if (s.materialSet().size() == 0) throw InputError(who(what) + ": this solver has no material yet (add_region adds one)");
 		return size_t(argInt(i, who(what), 0, double(s.materialSet().size() - 1)));
 	}
 	// Copy of material i as the Python object it was given as (ElasticMat or DpGkMat).
@@ -65,13 +65,6 @@ struct SolverWrap {
 		const auto& e = s.materialSet()[materialIndex(s, i, "material: index")];
 		if (e.kind == MaterialKind::DruckerPragerGradyKipp) return bp::object(std::make_shared<DpGkMat>(e.dpgk));
 		return bp::object(std::make_shared<ElasticMat>(e.elastic));
-	}
-	static ElasticMat elasticParameters(S& s, bp::object i) { return s.materialSet()[materialIndex(s, i, "elasticParameters: material")].elastic; }
-	static DpGkMat    dpgkParameters(S& s, bp::object i)
-	{
-		const auto& e = s.materialSet()[materialIndex(s, i, "dpgkParameters: material")];
-		if (e.kind != MaterialKind::DruckerPragerGradyKipp) throw InputError(who("dpgkParameters") + ": material is not a DpGkMat (use material(index))");
-		return e.dpgk;
 	}
 	static size_t    numMaterials(S& s) { return s.materialSet().size(); }
 	static bp::tuple materialKinds(S& s)
@@ -179,39 +172,36 @@ struct SolverWrap {
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
 		cls.def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"))))
-		        .def("addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses"), bp::arg("material") = 0),
+		        .def("_addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses"), bp::arg("material") = 0),
 		             "Adds particles (positions (N, D) [m], volumes [m³], masses [kg]) of material index `material` (addMaterial's return value).")
-		        .def("addMaterial", &addMaterial, bp::arg("material"), "Adds an ElasticMat or DpGkMat to the scene; returns its index for addParticles.")
+		        .def("_addMaterial", &addMaterial, bp::arg("material"), "Adds an ElasticMat or DpGkMat to the scene; returns its index for addParticles.")
 		        .def("material", &material, bp::arg("index"), "Copy of material `index` (ElasticMat or DpGkMat).")
-		        .def("cohesion", &cohesion, "Current cohesion per particle (Eq. 34) [Pa], storage order; NaN for non-DP–GK particles.")
-		        .def("setMaterial", &setMaterial, bp::arg("material"))
+		        .def("_cohesion", &cohesion, "Current cohesion per particle (Eq. 34) [Pa], storage order; NaN for non-DP–GK particles.")
+		        .def("_setMaterial", &setMaterial, bp::arg("material"))
 		        .def("addBoundaryPlane", &addPlane, (bp::arg("axis"), bp::arg("side"), bp::arg("position"), bp::arg("kind")))
-		        .def("setParticleForces", &setForces, (bp::arg("indices"), bp::arg("forces")))
+		        .def("_setParticleForces", &setForces, (bp::arg("indices"), bp::arg("forces")))
 		        .def("setParticleMaterial", &setParticleMaterial, (bp::arg("indices"), bp::arg("material")),
-		             "Particle slots `indices` (storage order, as the views) take material index `material` (addMaterial's return value, "
+		             "Particle slots `indices` (storage order, as the views) take material index `material` (material(i) reads it back, "
 		             "range [0, numMaterials - 1]) and that material's damage threshold eps0 (Eq. 37; 0 without damage), with no activated "
 		             "flaws; damage and plastic strain stay. The view 'material' is read-only: use this.")
-		        .def("step", static_cast<void (S::*)()>(&S::step))
-		        .def("advance", &advance, bp::arg("dt"))
+		        .def("_advance", &advance, bp::arg("dt"))
 		        .def("run", &run, bp::arg("steps"))
 		        .def("stableDt", &S::stableDt)
 		        .def("waveSpeed", &S::waveSpeed)
 		        .def("kineticEnergy", &S::kineticEnergy)
 		        .def("elasticEnergy", &S::elasticEnergy)
-		        .def("setNodeExcluded", &setNodeExcluded, (bp::arg("node"), bp::arg("excluded")))
+		        .def("_setNodeExcluded", &setNodeExcluded, (bp::arg("node"), bp::arg("excluded")))
 		        .def("requestSort", &S::requestSort)
-		        .def("elasticParameters", &elasticParameters, bp::arg("index") = 0)
-		        .def("dpgkParameters", &dpgkParameters, bp::arg("index") = 0)
-		        .def("loadScale", &loadScale, bp::arg("t"))
+		        .def("_loadScale", &loadScale, bp::arg("t"))
 		        .add_property("numParticles", &numParticles)
-		        .add_property("bytesPerParticle", &bytesPerParticle)
-		        .add_property("materialKind", &materialKind, "kind of material 0: 0 elastic, 1 DP–GK, -1 none (see materialKinds)")
-		        .add_property("materialKinds", &materialKinds, "kind of every material, by index: 0 elastic, 1 DP–GK")
+		        .add_property("_bytesPerParticle", &bytesPerParticle)
+		        .add_property("_materialKind", &materialKind, "kind of material 0: 0 elastic, 1 DP–GK, -1 none (see materialKinds)")
+		        .add_property("_materialKinds", &materialKinds, "kind of every material, by index: 0 elastic, 1 DP–GK")
 		        .add_property("numMaterials", &numMaterials)
 		        .add_property("spacing", &getSpacing)
 		        .add_property("origin", &getOrigin)
 		        .add_property("cells", &getCells)
-		        .add_property("storedNodes", &getStored)
+		        .add_property("_storedNodes", &getStored)
 		        .def("reserve", &reserve, bp::arg("particles"),
 		             "Room for this many particles: later addParticles up to that count keep the arrays (and live views) in place.")
 		        .def_readonly("lastDt", &S::lastDt)

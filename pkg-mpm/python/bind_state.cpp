@@ -173,14 +173,14 @@ struct StateWrap {
 		ParamBinding<S>::exposeProperties(cls); // settings and writable state, checked (SolverSettings.hpp)
 		cls.def("settings", &settings, "The settings (SolverSettings.hpp) as a dict {name: value}.")
 		        .def("setSettings", &setSettings, bp::arg("settings"), "Write settings from a dict (all or nothing; unknown names refused).")
-		        .def("phaseTimes", &phaseTimes)
-		        .def("resetPhaseTimes", &resetPhaseTimes)
-		        .def("getResumeState", &getResumeState)
-		        .def("setResumeState", &setResumeState, bp::arg("state"))
-		        .def("removedAccount", &removedAccount, (bp::arg("allRanks") = true),
+		        .def("_phaseTimes", &phaseTimes)
+		        .def("_resetPhaseTimes", &resetPhaseTimes)
+		        .def("_getResumeState", &getResumeState)
+		        .def("_setResumeState", &setResumeState, bp::arg("state"))
+		        .def("_removedAccount", &removedAccount, (bp::arg("allRanks") = true),
 		             "What left the grid and was removed (Solver.outside): {count, mass [kg], momentum (Σ m v) [kg·m/s], kinetic_energy [J], "
 		             "last_time [s], last_step, faces: {'x-': n, 'x+': n, …}}; MPI: over every rank (a collective), or this rank's with allRanks=False.")
-		        .def("removedParticles", &removedParticles,
+		        .def("_removedParticles", &removedParticles,
 		             "The removed particles in removal order as arrays: id, step, time [s], pos [m], vel [m/s] (at removal), mass [kg], damage, "
 		             "face (2·axis + 1 for the upper end), material, reason (0 outside = 'remove', 1 fully damaged, 2 detached); MPI: this rank's.")
 		        .def("_restoreRemoved", &restoreRemoved, (bp::arg("removed"), bp::arg("particles")),

@@ -145,13 +145,13 @@ struct ViewsWrap {
 	{
 		bp::class_<ViewOwner, std::shared_ptr<ViewOwner>, boost::noncopyable>((std::string("_ViewOwner") + name).c_str(), bp::no_init);
 		cls.def("view", &view, bp::arg("name"))
-		        .def("effectiveStress", &effectiveStress)
-		        .def("maxPrincipalStress", &maxPrincipalStress)
-		        .def("materialVelocity", &materialVelocity, "Velocity of each material point [m/s], (N, D), storage order: v + C (x − x̄), x̄ the centroid of a cut stencil's lumping weights.")
-		        .def("shapeFunctions", &shapeFunctions, bp::arg("point"))
-		        .def("nodePositions", &nodePositions)
-		        .def("nodeState", &nodeState)
-		        .def("excludedNodes", &excludedNodes);
+		        .def("_effectiveStress", &effectiveStress)
+		        .def("_maxPrincipalStress", &maxPrincipalStress)
+		        .def("_materialVelocity", &materialVelocity, "Velocity of each material point [m/s], (N, D), storage order: v + C (x − x̄), x̄ the centroid of a cut stencil's lumping weights.")
+		        .def("_shapeFunctions", &shapeFunctions, bp::arg("point"))
+		        .def("_nodePositions", &nodePositions)
+		        .def("_nodeState", &nodeState)
+		        .def("_excludedNodes", &excludedNodes);
 	}
 };
 } // namespace

@@ -1,6 +1,6 @@
 """yade_mpm: weighted-least-squares material point method (WLS-MPM) for YADE.
 
-Core solver in C++ (pkg-mpm/, module ``yade_mpm._core``), driven from YADE's O.engines through
+Core solver in C++ (pkg-mpm/, module ``yade_mpm._core``, built into build/py/yade_mpm), driven from YADE's O.engines through
 ``MpmEngine``. Quantities are SI; stress is tension-positive; 2D is plane strain per unit thickness.
 """
 import os as _os
@@ -11,7 +11,8 @@ import os as _os
 # Effective only if OpenMP was not initialised earlier in the process (e.g. by YADE); users may override.
 _os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
-from . import _guards
+from . import _build, _guards
+_build.extend(__path__)     # the compiled modules live in <checkout>/build/py/yade_mpm (yade_mpm._build)
 _guards.cap_omp_threads()   # before libgomp reads OMP_NUM_THREADS (loaded with _core)
 from . import parallel
 _core = parallel.load_core(__name__)   # the serial core, or under mpirun the MPI build (doc/developer/scaling.md)

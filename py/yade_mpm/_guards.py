@@ -73,10 +73,10 @@ def install(core):
         def reserve(self, particles, _raw=raw_reserve):
             n = particles
             if isinstance(n, numbers.Real) and not isinstance(n, bool) and math.isfinite(n) and n == int(n) and n > 0:
-                need, phys = int(n) * self.bytesPerParticle, _physical_memory()
+                need, phys = int(n) * self._bytesPerParticle, _physical_memory()
                 if phys and need > phys:
                     raise ValueError(f"reserve: particles = {int(n):,} need {need / 1e9:.3g} GB of particle arrays "
-                                     f"({self.bytesPerParticle} bytes each), more than this machine's {phys / 1e9:.3g} GB")
+                                     f"({self._bytesPerParticle} bytes each), more than this machine's {phys / 1e9:.3g} GB")
             return _raw(self, particles)
 
         view.__doc__ = ("view(name) -> live NumPy view (STORAGE order, no copy) of a particle array: x0.., v0.., C0.., "

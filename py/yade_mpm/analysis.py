@@ -204,7 +204,7 @@ def softening_end(solver, order=None):
     cohesion reaches its floor, (1 − c_r)·ε̄p_crit (Eq. 34); inf for particles of other materials, NaN for
     removed ones (rows as ``fields.get``)."""
     from .fields import id_order, _with_removed_rows
-    kinds = solver.materialKinds
+    kinds = solver._materialKinds
     mats = [solver.material(i) for i in range(solver.numMaterials)]
     end = np.array([(1 - m.residualCohesion) * m.critPlasticStrain if k == 1 else np.inf for m, k in zip(mats, kinds)])
     o = id_order(solver) if order is None else order

@@ -206,17 +206,17 @@ class RigidBodies:
         prm.validateFor(self.solver.spacing)
         prims = [self._primitives(b) for b in bodies]   # validates shapes before touching the solver
         s = self.solver
-        parts = [s.addRigidPart() for _ in bodies]
-        g = s.addContactGroup(parts, prm)
+        parts = [s._addRigidPart() for _ in bodies]
+        g = s._addContactGroup(parts, prm)
         for b, part, (plist, t) in zip(bodies, parts, prims):
             for kind, args in plist:
                 getattr(s, kind)(g, part, *args)
         if d0 == "initial":                # the first layer's distances at the bodies' poses now
             try:
                 self._read_parts(zip((b.id for b in bodies), parts))
-                s.captureContactD0(g)
+                s._captureContactD0(g)
             except ValueError:
-                s.removeLastContactGroup()   # refused (a particle inside the body): nothing registered
+                s._removeLastContactGroup()   # refused (a particle inside the body): nothing registered
                 raise
         for b, part, (plist, t) in zip(bodies, parts, prims):
             self._part_of[b.id] = len(self._parts)
@@ -230,7 +230,7 @@ class RigidBodies:
         particle keeps the default ½ V_p^{1/D}; an empty array for other groups."""
         if group not in self.groups:
             raise ValueError(f"group = {group!r} is not a contact group of these bodies; groups: {self.groups}")
-        return np.asarray(self.solver.contactInitialD0(group))
+        return np.asarray(self.solver._contactInitialD0(group))
 
     def _primitives(self, b):
         """[(solver method, args)], thickness for one body (a clump: its members in the clump frame)."""
@@ -259,16 +259,16 @@ class RigidBodies:
         if name == "Box":
             h = _vec(sh.extents)
             if d == 3:
-                return [("addContactBox", (tuple(cL), RL, tuple(h)))], (0.0, 0.0)
+                return [("_addContactBox", (tuple(cL), RL, tuple(h)))], (0.0, 0.0)
             self._planar(RL, b.id)
             corners_z = zref + cL[2] + np.array([-1, 1]) * (np.abs(RL[2, :]) @ h)
             if not (corners_z[0] < 0 < corners_z[1]):
                 return [], tuple(corners_z)
-            return [("addContactBox", (tuple(cL[:2]), RL[:2, :2], tuple(h[:2])))], tuple(corners_z)
+            return [("_addContactBox", (tuple(cL[:2]), RL[:2, :2], tuple(h[:2])))], tuple(corners_z)
         if name == "Facet":
             v = np.array([cL + RL @ _vec(x) for x in sh.vertices])
             if d == 3:
-                return [("addContactElement", (v,))], (0.0, 0.0)
+                return [("_addContactElement", (v,))], (0.0, 0.0)
             self._planar(RL, b.id)
             z = zref + v[:, 2]
             seg = []
@@ -280,7 +280,7 @@ class RigidBodies:
             zr = (z.min(), z.max())
             if len(seg) != 2 or np.linalg.norm(seg[0] - seg[1]) == 0:
                 return [], zr
-            return [("addContactElement", (np.array(seg),))], zr
+            return [("_addContactElement", (np.array(seg),))], zr
         if name == "Wall":
             if clump_member:
                 raise ValueError(f"body id {b.id}: a Wall cannot be part of a clump for MPM contact")
@@ -289,7 +289,7 @@ class RigidBodies:
                 raise ValueError(f"body id {b.id}: a Wall with axis {axis} is parallel to the 2D plane (use axis 0 or 1)")
             n = np.zeros(d)
             n[axis] = -1.0 if sense < 0 else 1.0
-            return [("addContactPlane", (tuple(np.zeros(d)), tuple(n), sense == 0))], (-0.5, 0.5)
+            return [("_addContactPlane", (tuple(np.zeros(d)), tuple(n), sense == 0))], (-0.5, 0.5)
         raise ValueError(f"body id {b.id} has shape {name}, which MPM contact does not support "
                          "(supported: Box, Wall, Facet, Clump of Box/Facet)")
 
@@ -304,7 +304,7 @@ class RigidBodies:
         from yade import O
         self._read_parts((bid, part) for bid, part, _ in self._parts)
         for bid, part, t in self._parts:
-            self.solver.setRigidPartMass(part, *body_inertia(O.bodies[bid], self.dim, t))
+            self.solver._setRigidPartMass(part, *body_inertia(O.bodies[bid], self.dim, t))
 
     def _read_parts(self, pairs):
         from yade import O
@@ -314,9 +314,9 @@ class RigidBodies:
             R, x, v, w = _rot(st.ori), st.pos, st.vel, st.angVel
             if d == 2:
                 self._planar(R, bid)
-                s.setRigidPartState(part, (x[0], x[1]), R[:2, :2], (v[0], v[1]), w[2])
+                s._setRigidPartState(part, (x[0], x[1]), R[:2, :2], (v[0], v[1]), w[2])
             else:
-                s.setRigidPartState(part, (x[0], x[1], x[2]), R, (v[0], v[1], v[2]), (w[0], w[1], w[2]))
+                s._setRigidPartState(part, (x[0], x[1], x[2]), R, (v[0], v[1], v[2]), (w[0], w[1], w[2]))
 
     def write(self):
         """Contact reactions of the last MPM step into O.forces (2D: per-metre values × thickness)."""
@@ -324,7 +324,7 @@ class RigidBodies:
         from yade import Vector3
         s = self.solver
         for bid, part, t in self._parts:
-            f, m = s.rigidPartForce(part), s.rigidPartTorque(part)
+            f, m = s._rigidPartForce(part), s._rigidPartTorque(part)
             if self.dim == 2:
                 O.forces.addF(bid, Vector3(f[0] * t, f[1] * t, 0.0))
                 O.forces.addT(bid, Vector3(0.0, 0.0, m * t))
@@ -341,11 +341,11 @@ class RigidBodies:
 
     def force(self, bid):
         """Reaction force on body `bid` from the last MPM step [N] (2D: [N/m], per metre of thickness)."""
-        return np.array(self.solver.rigidPartForce(self._part(bid)[1]))
+        return np.array(self.solver._rigidPartForce(self._part(bid)[1]))
 
     def torque(self, bid):
         """Its moment about the body's centre [N m] (2D: ω_z component per metre, [N m/m])."""
-        return np.array(self.solver.rigidPartTorque(self._part(bid)[1]))
+        return np.array(self.solver._rigidPartTorque(self._part(bid)[1]))
 
     def thickness(self, bid):
         """The z-extent t [m] that scales the 2D per-metre reaction into O.forces."""

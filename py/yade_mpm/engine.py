@@ -89,7 +89,7 @@ class MpmEngine:
             for b in self._adapters:
                 b.read()
             t = _time.perf_counter()
-            s.advance(O.dt)
+            s._advance(O.dt)
             gov = governor()
             if gov is not None:
                 gov.tick(_time.perf_counter() - t)   # on a shared host the faster thread count (yade_mpm.threads)

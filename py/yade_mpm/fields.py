@@ -40,7 +40,7 @@ FIELDS = {
     "max_principal_stress": ("maxPrincipalStress()", "Pa", "largest principal value of stress (σ̃max, tension positive)"),
     "damage": ("damage", "-", "Grady–Kipp damage D in [0, 1] (0 for elastic particles)"),
     "plastic_strain": ("epsP", "-", "accumulated plastic strain ε̄p (0 for elastic particles)"),
-    "cohesion": ("cohesion()", "Pa", "current cohesion c(ε̄p) (Eq. 34; NaN for elastic particles); DP–GK scenes only"),
+    "cohesion": ("_cohesion()", "Pa", "current cohesion c(ε̄p) (Eq. 34; NaN for elastic particles); DP–GK scenes only"),
     "mass": ("mass", "kg", "mass (per metre of thickness in 2D)"),
     "volume": ("vol", "m³", "current volume (m² × 1 m in 2D)"),
     "material": ("material", "-", "material index (solver.material(i))"),
@@ -87,9 +87,9 @@ def _removed_ids(solver):
     """Ids of the removed particles of a one-process solver (None when there are none or under MPI, where
     each rank reads only its own particles)."""
     from .parallel import size
-    if solver.removedAccount()["count"] == 0 if size() == 1 else True:
+    if solver._removedAccount()["count"] == 0 if size() == 1 else True:
         return None
-    return solver.removedParticles()["id"]
+    return solver._removedParticles()["id"]
 
 
 def _with_removed_rows(solver, name, live, order):
@@ -109,7 +109,7 @@ def _with_removed_rows(solver, name, live, order):
     if name == "material":
         out = np.empty(total, dtype=live.dtype)
         out[ids] = live
-        out[gone] = solver.removedParticles()["material"]
+        out[gone] = solver._removedParticles()["material"]
         return out
     out = np.full((total,) + live.shape[1:], np.nan)
     out[ids] = live
@@ -123,8 +123,8 @@ def removed(solver):
     removal), mass [kg], damage, face ('x+' …), material, reason ('remove', 'damaged' = D = 1, 'detached' =
     not in the body's cluster). Under MPI the account is over every rank (a collective), the particles are
     this rank's."""
-    d = dict(solver.removedAccount())
-    p = dict(solver.removedParticles())
+    d = dict(solver._removedAccount())
+    p = dict(solver._removedParticles())
     dim = dim_of(solver)
     p["face"] = np.array([f"{'xyz'[f // 2]}{'+' if f % 2 else '-'}" for f in p["face"]], dtype=f"<U2")
     p["reason"] = np.array([("remove", "damaged", "detached")[r] for r in p["reason"]], dtype="<U8")
@@ -154,24 +154,24 @@ def _get_live(solver, name, o, d):
     if name == "pos":
         return np.column_stack([solver.view(f"x{a}") for a in range(d)])[o]
     if name == "vel":
-        return solver.materialVelocity()[o]
+        return solver._materialVelocity()[o]
     if name == "momentum":
         return (solver.view("mass")[:, None] * np.column_stack([solver.view(f"v{a}") for a in range(d)]))[o]
     if name == "stress":
-        return solver.effectiveStress()[o]
+        return solver._effectiveStress()[o]
     if name == "undamaged_stress":
         return np.column_stack([solver.view(f"sig{k}") for k in range(len(SYM_NAMES[d]))])[o]
     if name == "max_principal_stress":
-        return solver.maxPrincipalStress()[o]
+        return solver._maxPrincipalStress()[o]
     if name in ("damage", "plastic_strain"):
         try:
             return solver.view(FIELDS[name][0])[o].copy()
         except ValueError:                       # not allocated: no DP–GK material in the scene
             return np.zeros(len(o))
     if name == "cohesion":
-        if 1 not in solver.materialKinds:
+        if 1 not in solver._materialKinds:
             raise ValueError("cohesion exists only for the DP–GK material")
-        return solver.cohesion()[o]              # Eq. 34 with each particle's material; NaN for other materials
+        return solver._cohesion()[o]              # Eq. 34 with each particle's material; NaN for other materials
     return solver.view(FIELDS[name][0])[o].copy()
 
 
@@ -180,7 +180,7 @@ def fields(solver, names=None):
     particle-id order, plus 'time' [s] and 'steps'; a dict ready for ``np.savez`` or ``analysis``."""
     o = id_order(solver)
     if names is None:
-        names = [n for n in FIELDS if n != "cohesion" or 1 in solver.materialKinds]
+        names = [n for n in FIELDS if n != "cohesion" or 1 in solver._materialKinds]
     out = {n: get(solver, n, o) for n in names}
     out["time"], out["steps"] = float(solver.time), int(solver.steps)
     return out

@@ -97,7 +97,7 @@ def particle_fields(solver, x0=None):
     fields["max_tensile_principal_stress"] = np.maximum(fields["max_principal_stress"], 0.0)
     if solver.numMaterials > 1:
         fields["material"] = field("material").astype(np.int64)   # index into solver.material(i)
-    if 1 in solver.materialKinds:                 # some material is DP–GK
+    if 1 in solver._materialKinds:                 # some material is DP–GK
         from .analysis import softening_end
         fields["damage"] = field("damage")
         fields["plastic_strain"] = field("plastic_strain")

@@ -51,5 +51,5 @@ class Progress:
     def _removed(self):
         if self.solver is None:
             return ""
-        acc = self.solver.removedAccount(allRanks=False)   # no collective: ranks print at their own times
+        acc = self.solver._removedAccount(allRanks=False)   # no collective: ranks print at their own times
         return f"  removed {acc['count']} ({acc['mass']:.4g} kg)" if acc["count"] else ""

@@ -181,7 +181,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
     before_step: f(solver) called before each step (e.g. to take ``stableDt()`` of the state before it).
     on_interrupt: "raise" (re-raise KeyboardInterrupt after the at_end outputs) or "return".
     on_error: "raise" (a solver error propagates) or "return" (RunResult with reason "error" and its message).
-    advance: f() that advances the whole simulation by one step (default ``solver.step``); YADE's
+    advance: f() that advances the whole simulation by one step (default ``solver.run(1)``); YADE's
     ``O.step`` when the solver runs inside O.engines through an MpmEngine (rigid bodies, DEM).
     Returns a RunResult."""
     if end_time is not None and not _real(end_time):
@@ -198,7 +198,7 @@ def run(solver, end_time=None, max_steps=None, progress=None, label="mpm", stop=
         raise ValueError(f"on_error = {on_error!r} must be 'raise' or 'return'")
     if advance is not None and not callable(advance):
         raise ValueError(f"advance = {advance!r} must be callable as f() (one step of the simulation)")
-    step = advance if advance is not None else _governed(solver.step)   # through YADE the MpmEngine reports the steps
+    step = advance if advance is not None else _governed(lambda: solver.run(1))   # through YADE the MpmEngine reports the steps
     outs = _outputs(every, outputs)
     if progress is None or progress is False:
         prog = None

@@ -91,11 +91,11 @@ def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="
     x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
     first = solver.numParticles
     index = material_index(solver, material)
-    solver.addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
+    solver._addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
     _refill_gaps(solver, solver.spacing / ppc)
     if gap_nodes == "excluded" and len(holes):
         for i in thin_gap_nodes(solver, lo, hi, solver.spacing / ppc, holes):
-            solver.setNodeExcluded(int(i), True)
+            solver._setNodeExcluded(int(i), True)
     return np.arange(first, first + len(x))
 
 
@@ -115,7 +115,7 @@ def thin_gap_nodes(solver, lo, hi, dp, holes):
     if not thin:
         return np.zeros(0, np.int64)
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    xn = solver.nodePositions()
+    xn = solver._nodePositions()
     cand = np.nonzero(np.all((xn > lo + 1e-9 * h) & (xn < hi - 1e-9 * h), axis=1))[0]
     # strictly inside a thin hole: the node and its 3^D − 1 neighbours at 1e-6 l are all inside
     offsets = 1e-6 * h * (np.array(np.meshgrid(*[[-1, 0, 1]] * d, indexing="ij")).reshape(d, -1).T)
@@ -145,24 +145,24 @@ def thin_gap_nodes(solver, lo, hi, dp, holes):
 def _refill_gaps(solver, dp):
     """Gap nodes that particles added since now cover (a filled flaw) take part in the fits again."""
     from scipy.spatial import cKDTree
-    gap = np.nonzero(solver.excludedNodes() & _core.exclusionBits["gap"])[0]
+    gap = np.nonzero(solver._excludedNodes() & _core.exclusionBits["gap"])[0]
     if len(gap) == 0:
         return
     d = dim_of(solver)
     tree = cKDTree(np.column_stack([solver.view(f"x{a}") for a in range(d)]))
-    near, _ = tree.query(solver.nodePositions()[gap], p=np.inf)
+    near, _ = tree.query(solver._nodePositions()[gap], p=np.inf)
     for i in gap[near <= 0.5 * dp * (1 + 1e-6)]:
-        solver.setNodeExcluded(int(i), False)
+        solver._setNodeExcluded(int(i), False)
 
 
 def material_index(solver, material):
     """Index of `material` in the solver: an identical material (same type and parameters) already added
-    is reused, else it is added (solver.addMaterial)."""
+    is reused, else it is added (solver._addMaterial)."""
     for i in range(solver.numMaterials):
         m = solver.material(i)
         if type(m) is type(material) and m.toDict() == material.toDict():
             return i
-    return solver.addMaterial(material)
+    return solver._addMaterial(material)
 
 
 def set_initial_stress(solver, stress):
@@ -208,7 +208,7 @@ def apply_traction(solver, indices, traction, area):
         old = np.column_stack([solver.view(f"trac{a}")[indices] for a in range(d)])
     except ValueError:
         old = 0.0
-    solver.setParticleForces(np.asarray(indices, np.int64), old + t * area)
+    solver._setParticleForces(np.asarray(indices, np.int64), old + t * area)
 
 
 def _axis_side(solver, axis, side):

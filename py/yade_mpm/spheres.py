@@ -131,16 +131,16 @@ class DemSpheres:
         self.bound, self.thick = grow(self.bound, 0.0), grow(self.thick, 1.0)
         self.is_clump, self.active = grow(self.is_clump, False), grow(self.active, False)
         for k, (b, (members, zext, brad), prm) in enumerate(rows, start=n0):
-            part = s.addRigidPart()
-            g = s.addContactGroup([part], prm)
+            part = s._addRigidPart()
+            g = s._addContactGroup([part], prm)
             for cL, r in members:
-                s.addContactSphere(g, part, tuple(cL[:d]), float(r))
+                s._addContactSphere(g, part, tuple(cL[:d]), float(r))
             self.parts[k], self.groups[k], self.bound[k] = part, g, brad
             self.thick[k] = 1.0 if d == 3 else (thickness if thickness is not None else zext)
             self.is_clump[k] = type(b.shape).__name__ == "Clump"
             if self.is_clump[k]:
                 self._R0[k] = _rot(b.state.ori)
-        s.setContactGroupsEnabled(self.groups[n0:], False)
+        s._setContactGroupsEnabled(self.groups[n0:], False)
         self._next_check = 0            # the new bodies get a broad-phase check at the next read()
         return self.groups[n0:].tolist()
 
@@ -220,9 +220,9 @@ class DemSpheres:
         act = gap <= 0
         on, off = self.groups[act & ~self.active], self.groups[~act & self.active]
         if len(on):
-            s.setContactGroupsEnabled(on, True)
+            s._setContactGroupsEnabled(on, True)
         if len(off):
-            s.setContactGroupsEnabled(off, False)
+            s._setContactGroupsEnabled(off, False)
         self.active = act
         self.checks += 1
         dt = max(O.dt, 1e-300)
@@ -260,20 +260,20 @@ class DemSpheres:
                 if not (abs(R[0, 2]) < 1e-9 and abs(R[1, 2]) < 1e-9):
                     raise ValueError(f"body id {self.ids[j]}: clump rotated out of the x–y plane (2D: rotation about z only; "
                                      "block it with blockedDOFs = 'zXY')")
-                s.setRigidPartState(int(self.parts[j]), (q.pos[0], q.pos[1]), R[:2, :2], (q.vel[0], q.vel[1]), q.angVel[2])
+                s._setRigidPartState(int(self.parts[j]), (q.pos[0], q.pos[1]), R[:2, :2], (q.vel[0], q.vel[1]), q.angVel[2])
             else:
-                s.setRigidPartState(int(self.parts[j]), tuple(q.pos), R, tuple(q.vel), tuple(q.angVel))
+                s._setRigidPartState(int(self.parts[j]), tuple(q.pos), R, tuple(q.vel), tuple(q.angVel))
         st = [O.bodies[int(i)].state for i in self.ids[k]]
         x = np.array([[q.pos[a] for a in range(d)] for q in st])
         v = np.array([[q.vel[a] for a in range(d)] for q in st])
         w = np.array([[q.angVel[2]] for q in st]) if d == 2 else np.array([[q.angVel[a] for a in range(3)] for q in st])
-        s.setRigidPartMotions(self.parts[k], x, v, w)
+        s._setRigidPartMotions(self.parts[k], x, v, w)
         mI = [body_inertia(O.bodies[int(self.ids[j])], d, self.thick[j]) for j in k]
         m = np.array([a for a, _ in mI])
         # 3D: the part frame of a clump is not its principal frame; its smallest moment on every axis
         # (a lower bound: the stick step expects more turning than the clump makes; it sticks less, never overshoots)
         I = np.array([[b] if d == 2 else [min(b)] * 3 for _, b in mI])
-        s.setRigidPartMasses(self.parts[k], m, I)
+        s._setRigidPartMasses(self.parts[k], m, I)
 
     @_timed
     def write(self):
@@ -283,7 +283,7 @@ class DemSpheres:
         k = np.nonzero(self.active)[0]
         if not len(k):
             return
-        f, m = self.solver.rigidPartReactions(self.parts[k])
+        f, m = self.solver._rigidPartReactions(self.parts[k])
         for j, fj, mj in zip(k, f, m):
             bid, t = int(self.ids[j]), self.thick[j]
             if self.dim == 2:
@@ -304,7 +304,7 @@ class DemSpheres:
 
     def force(self, bid):
         """Reaction on body `bid` from the last MPM step [N] (2D: per metre of thickness [N/m])."""
-        f, _ = self.solver.rigidPartReactions([int(self.parts[self._index(bid)])])
+        f, _ = self.solver._rigidPartReactions([int(self.parts[self._index(bid)])])
         return f[0]
 
     def thickness(self, bid):

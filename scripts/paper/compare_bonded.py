@@ -169,7 +169,7 @@ def mpm_uniaxial(flaw, a):
             break
     wall, cpu = time.time() - t0, time.process_time() - c0
     o = id_order(s)
-    acc = s.removedAccount()                                   # debris that left the grid (Solver.outside)
+    acc = ym.removed(s)                                   # debris that left the grid (Solver.outside)
     return dict(strain=np.array(strain), stress=np.array(stress), particles=int(s.numParticles + acc["count"]), wall_time_s=wall,
                 cpu_time_s=cpu, pos=ym.get(s, "pos", o), damage=ym.get(s, "damage", o), steps=int(s.steps), dt=float(s.lastDt),
                 end_reason=end_reason, error=error, removed_particles=int(acc["count"]), removed_mass_kg=float(acc["mass"]))

@@ -42,7 +42,7 @@ def energy_left(courant, wavelength_cells, t_end, l=2e-3, amplitude=0.1):
 
     e0 = energy()
     while s.time < t_end:
-        s.step()
+        s.run(1)
     return energy() / e0, s.steps
 
 

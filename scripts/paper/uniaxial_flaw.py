@@ -121,7 +121,7 @@ def one_run(variant, mu, c_mpa, a):
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
                  plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"],
-                 removed_particles=int(s.removedAccount()["count"]), removed_mass_kg=float(s.removedAccount()["mass"]))   # debris off the grid
+                 removed_particles=int(ym.removed(s)["count"]), removed_mass_kg=float(ym.removed(s)["mass"]))   # debris off the grid
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "

@@ -13,7 +13,7 @@ an old and a new build run the same code paths and physics; `tunnel_paper` / `tu
 tunnel (cases.arch_tunnel "intact", 1 mm / 2 mm grid) stepped through YADE with its rigid platen, as
 scripts/paper/tunnel_spalling.py runs it (builds with cases.arch_tunnel only).
 
-    git -C . worktree add /tmp/wt-before before-session        # build it there: cmake … && cmake --build …
+    git -C . worktree add /tmp/wt-before before-session        # build it there: cmake -S . -B build && cmake --build build
     flock /work/bench.lock /usr/bin/python3 scripts/tools/bench_ab.py --out out/ab \\
         before=/tmp/wt-before/py now=py --cases elastic2d_80k,dpgk2d_80k,free_elastic,free_dpgk --threads 1,2
 
@@ -50,11 +50,11 @@ s.view("v0")[:] = 40.0 * (x0 - 1.0)                            # the benchmark's
 s.view("v1")[:] = -40.0 * (x1 - 0.5)
 del x0, x1
 s.run(WARMUP)
-s.resetPhaseTimes()
+s._resetPhaseTimes()
 c0, t0 = time.process_time(), time.perf_counter()
 s.run(STEPS)
 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.numParticles, phases=s.phaseTimes())))
+print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.numParticles, phases=s._phaseTimes())))
 '''
 FREE_STEPS = (250, 20)
 
@@ -67,12 +67,12 @@ from yade import O
 s, b = cases.arch_tunnel("intact", SPACING)
 for _ in range(WARMUP):
     O.step()
-s.resetPhaseTimes()
+s._resetPhaseTimes()
 c0, t0 = time.process_time(), time.perf_counter()
 for _ in range(STEPS):
     O.step()
 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.numParticles, phases=s.phaseTimes())))
+print("BENCH " + json.dumps(dict(steps=STEPS, wall=wall, cpu=cpu, particles=s.numParticles, phases=s._phaseTimes())))
 '''
 TUNNEL_CASES = {"tunnel_paper": (0.001, 200, 20), "tunnel_2mm": (0.002, 400, 20)}   # spacing [m], timed and warm-up steps
 

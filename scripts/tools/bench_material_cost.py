@@ -20,11 +20,11 @@ def measure(mat, size, h, steps):
     ym.set_initial_stress(s, (-10e6, -5e6, -4e6, 0.0))   # inside every criterion
     s.gravity = (0.0, -9.81)
     s.run(5)
-    p0 = dict(s.phaseTimes())
+    p0 = dict(s._phaseTimes())
     t0 = time.time()
     s.run(steps)
     wall = time.time() - t0
-    p1 = s.phaseTimes()
+    p1 = s._phaseTimes()
     n = s.numParticles * steps
     return dict(particles=s.numParticles, ns_per_particle_step=1e9 * wall / n,
                 stress_ns_per_particle_step=1e9 * (p1["stress"] - p0["stress"]) / n)

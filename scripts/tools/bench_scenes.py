@@ -87,12 +87,12 @@ def timed(build, steps, warmup, advance=None):
     s = build()
     advance = advance or s.run   # (a YADE scene passes its own: O.step)
     advance(warmup)
-    s.resetPhaseTimes()
+    s._resetPhaseTimes()
     c0, t0 = time.process_time(), time.perf_counter()
     advance(steps)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s.phaseTimes(), particles=s.numParticles,
-               bytes_per_particle=s.bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
+    out = dict(steps=steps, wall=wall, cpu=cpu, phases=s._phaseTimes(), particles=s.numParticles,
+               bytes_per_particle=s._bytesPerParticle, rss_per_particle=(peak_rss_bytes() - rss0) / s.numParticles,
                threads=ym.getThreads())
     out.update(material_stats(s))
     return out, s

@@ -33,11 +33,11 @@ def main():
     s = build_scene(len(a.cells), a.material, tuple(a.cells))
     n_total = s.numParticles
     s.run(a.warmup)
-    p0 = dict(s.phaseTimes())
+    p0 = dict(s._phaseTimes())
     t0 = time.perf_counter()
     s.run(a.steps)
     dt = (time.perf_counter() - t0) / a.steps
-    ph = {k: (v - p0.get(k, 0.0)) / a.steps for k, v in dict(s.phaseTimes()).items()}
+    ph = {k: (v - p0.get(k, 0.0)) / a.steps for k, v in dict(s._phaseTimes()).items()}
     info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "firstLayers": [], "haloBytesSent": 0}
     print(json.dumps(dict(rank=info["rank"], ranks=info["size"], threads=ym.getThreads(), particles_total=n_total,
                           particles=s.numParticles, seconds_per_step=dt, phase_seconds_per_step=ph,

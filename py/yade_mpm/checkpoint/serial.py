@@ -34,7 +34,7 @@ def _particle_arrays(solver):
             out[n] = solver.view(n)
         except ValueError:
             pass                                  # optional array not allocated in this scene
-    nreal = solver.getResumeState()["realFields"]
+    nreal = solver._getResumeState()["realFields"]
     if len(out) != nreal:
         raise CheckpointError(f"the core holds {nreal} particle arrays but the checkpoint knows {len(out)} "
                               f"({', '.join(out)}); update yade_mpm.checkpoint._field_names")
@@ -68,9 +68,9 @@ def solver_fingerprint(solver, ids=None):
             "cells": list(solver.cells), "particles": int(len(order)),
             "arrays": sorted(k for k in arrs if k not in ("id", "material")),
             "mass_vol0": _digest(arrs["mass"][order], arrs["vol0"][order]),
-            "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver.materialKinds],
+            "loads": _digest(*loads) if loads else None, "materialKinds": [int(k) for k in solver._materialKinds],
             "materials": [solver.material(i).toDict() for i in range(solver.numMaterials)],
-            "contact": [solver.contactParams(g).toDict() for g in range(solver.numContactGroups)],   # ContactParams.hpp
+            "contact": [solver._contactParams(g).toDict() for g in range(solver._numContactGroups)],   # ContactParams.hpp
             "material_index": _digest(arrs["material"][order])}
 
 
@@ -79,9 +79,9 @@ _REMOVED = ("id", "step", "time", "pos", "vel", "mass", "damage", "face", "mater
 
 def _solver_state(solver):
     arrs = {k: np.array(v, copy=True) for k, v in _particle_arrays(solver).items()}
-    for k, v in solver.removedParticles().items():   # particles removed after leaving the grid (this rank's)
+    for k, v in solver._removedParticles().items():   # particles removed after leaving the grid (this rank's)
         arrs[f"removed_{k}"] = np.array(v, copy=True)
-    rs = solver.getResumeState()
+    rs = solver._getResumeState()
     arrs["blockStart"] = np.array(rs["blockStart"], copy=True)
     arrs["scalars"] = np.array([float(rs[k]) for k in _STATE_SCALARS], dtype=np.float64)
     return arrs
@@ -105,7 +105,7 @@ def _restore_solver(solver, arrs, settings):
     old = solver.settings()
     try:
         solver.setSettings(settings)              # all or nothing, each value checked against its range
-        solver.setResumeState(sc)                 # checks the block schedule before changing anything
+        solver._setResumeState(sc)                 # checks the block schedule before changing anything
     except ValueError as e:
         solver.setSettings(old)
         raise CheckpointError(f"checkpoint: {e}") from None
@@ -197,7 +197,7 @@ def save(path, solvers=None, yade=None, meta=None, extra=None):
                           "meta": meta, "extra": extra, "solvers": {}, "settings": {}, "yade": None}
     if mpi:
         header["mpi"] = {name: cmpi.header_of(s) for name, s in sol.items()}   # a collective: every rank saves
-    header["removed"] = {name: int(s.removedAccount()["count"]) for name, s in sol.items()}   # MPI: over the ranks
+    header["removed"] = {name: int(s._removedAccount()["count"]) for name, s in sol.items()}   # MPI: over the ranks
     for name, s in sol.items():
         header["solvers"][name] = solver_fingerprint(s)
         header["settings"][name] = s.settings()   # JSON floats round-trip exactly

@@ -136,7 +136,7 @@ def mode_period(solver, shape, t_end):
     (linearly interpolated), stepping `solver` to `t_end` [s]."""
     t, q = [], []
     while solver.time < t_end:
-        solver.step()
+        solver.run(1)
         t.append(solver.time)
         q.append(np.sum(solver.view("mass") * solver.view("v0") * shape(solver.view("x0"))))
     t, q = np.array(t), np.array(q)

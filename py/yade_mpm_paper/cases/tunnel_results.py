@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from yade_mpm.fields import fields as _fields
+from yade_mpm.fields import fields as _fields, removed as _removed
 from yade_mpm.output import sample_curve as _sample
 from .tunnel import tunnel_report, tunnel_where
 
@@ -57,7 +57,7 @@ def summary_entry(case, solver, state, result, curve_step_mm):
     c = np.array(st["curve"]) if st["curve"] else np.zeros((0, 3))
     sym_key = "08ms" if "08ms" in snap else (sorted(snap)[-1] if snap else None)
     fc = st["first_crack"]
-    acc = solver.removedAccount()
+    acc = _removed(solver)
     return {"case": case, "grid_spacing_m": solver.spacing, "particles": int(solver.numParticles), "steps": int(st.get("steps", solver.steps)),
             "wall_time_s": round(st["wall"], 2),
             "particle_steps_per_s": float(solver.numParticles * st["steps_run"] / st["wall"]) if st["wall"] > 0 else None,

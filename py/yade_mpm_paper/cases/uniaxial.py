@@ -38,11 +38,11 @@ def exclude_nodes_inside(solver, polygon):
     excluded."""
     if not is_thin(polygon, solver.spacing):
         return 0
-    xn = solver.nodePositions()
+    xn = solver._nodePositions()
     lo, hi = np.asarray(solver.origin), np.asarray(solver.origin) + solver.spacing * np.asarray(solver.cells)
     inside = polygon.contains(xn) & np.all((xn > lo + 1e-12) & (xn < hi - 1e-12), axis=1)
     for i in np.nonzero(inside)[0]:
-        solver.setNodeExcluded(int(i), True)
+        solver._setNodeExcluded(int(i), True)
     return int(inside.sum())
 
 

@@ -25,9 +25,9 @@ import time
 
 import numpy as np
 
-from yade_mpm import runner
+from yade_mpm import DpGkMat, runner
 from yade_mpm._core import MpmSimulationError
-from yade_mpm.fields import SYM_NAMES, dim_of, get
+from yade_mpm.fields import SYM_NAMES, dim_of, get, removed
 
 # Allowed excess of KE + U_el over the input energy. Explicit (symplectic-Euler-like) integration does
 # not conserve the discrete energy exactly; its oscillation is O(C) of the energy in the highest modes,
@@ -101,7 +101,7 @@ def _removed_as_expected(spec, count):
 def paper_dt_limit(s):
     """l/(v_c + max‖v‖) of the paper's stability condition from the particle arrays and the material,
     independently of the solver's cached ρ_min and max speed: v_c = √((K + 4G/3)/ρ_min)."""
-    m = s.elasticParameters()
+    m = s.material(0)
     rho_min = np.min(s.view("mass") / s.view("vol"))
     v = np.sqrt(sum(s.view(f"v{a}") ** 2 for a in range(len(s.origin))))
     return s.spacing / (math.sqrt((m.bulk() + 4 * m.shear() / 3) / rho_min) + v.max())
@@ -127,7 +127,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
     def check(s):
         nonlocal nan_seen, outcome, message
         after = paper_dt_limit(s)  # paper's Δt ≤ l/(v_c+|v|), C = 1, after the step
-        tot = s.kineticEnergy() + s.elasticEnergy() + s.removedAccount()["kinetic_energy"]   # what left the grid counts
+        tot = s.kineticEnergy() + s.elasticEnergy() + removed(s)["kinetic_energy"]   # what left the grid counts
         hist["t"].append(s.time)
         hist["total"].append(tot)
         hist["input"].append(e0 + s.externalWork)
@@ -174,7 +174,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
         "message": message,
         "error_message_clear": bool(error_is_clear(message)) if outcome == "stopped_with_error" else None,
     }
-    acc = s.removedAccount()
+    acc = removed(s)
     summary["removed_particles"] = int(acc["count"])
     summary["removed_mass_kg"] = float(acc["mass"])
     summary["removed_kinetic_energy_J"] = float(acc["kinetic_energy"])
@@ -188,7 +188,7 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
         summary["momentum_error_rel"] = float(np.linalg.norm(p1 - p0) / scale)
         summary["momentum_conserved"] = bool(summary["momentum_error_rel"] <= MOMENTUM_TOL)
     momentum_ok = summary.get("momentum_conserved", True)
-    if s.materialKind == 1:
+    if isinstance(s.material(0), DpGkMat):
         d = s.view("damage")
         summary["fraction_fully_damaged"] = float(np.mean(d >= 1.0))
         summary["max_plastic_strain"] = float(np.max(s.view("epsP")))
@@ -199,5 +199,5 @@ def run_case(name, build, fast=False, max_steps=None, progress=True, courant=Non
                              and (outcome != "stopped_with_error" or summary["error_message_clear"]))
     hist["ratio"] = ratio
     hist["pos"] = get(s, "pos")
-    hist["damage"] = get(s, "damage") if s.materialKind == 1 else None
+    hist["damage"] = get(s, "damage") if isinstance(s.material(0), DpGkMat) else None
     return summary, hist
