@@ -54,6 +54,7 @@ public:
 			for (int a = 0; a < D; ++a) xk[k * D + a] = x[kept[k] * D + a];
 			vk[k] = vol[kept[k]], mk[k] = mass[kept[k]];
 		}
+		P.reserve(P.n + kept.size()); // exact growth: a doubling vector would hold up to 2× the rank's particles
 		P.append(xk.data(), vk.data(), mk.data(), kept.size(), g.origin, g.upper(), material);
 		for (size_t k = 0; k < kept.size(); ++k) P.id[old + k] = int64_t(first + kept[k]); // the id of 1 process
 		return true;
@@ -333,11 +334,11 @@ private:
 		ensureFields(P, opt); // a rank without particles had none of them (empty arrays)
 		size_t i = 0; // field index, in pack's order
 		P.forEachRealField([&](std::vector<Real>& f) {
-			f.resize(P.n);
+			f.reserve(P.n), f.resize(P.n); // exact growth (no doubling)
 			for (size_t j = 0; j < count; ++j) f[n0 + j] = buf[j * nf + i];
 			++i;
 		});
-		P.id.resize(P.n), P.mat.resize(P.n);
+		P.id.reserve(P.n), P.mat.reserve(P.n), P.id.resize(P.n), P.mat.resize(P.n);
 		for (size_t j = 0; j < count; ++j) {
 			std::memcpy(&P.id[n0 + j], &buf[j * nf + i], sizeof(int64_t));
 			P.mat[n0 + j] = uint8_t(buf[j * nf + i + 1]);

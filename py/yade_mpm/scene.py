@@ -125,7 +125,7 @@ def _add_region_distributed(solver, material, lo, hi, ppc, holes, keep, gap_node
     return np.arange(first, first + total)
 
 
-CHUNK = 1 << 18   # particles generated at once by a distributed add_region (every rank generates every chunk)
+CHUNK = 1 << 17   # particles generated at once by a distributed add_region (every rank generates every chunk)
 
 
 def thin_gap_nodes(solver, lo, hi, dp, holes):
