@@ -12,7 +12,7 @@ from test_mpi import LAUNCH, ROOT, needs_mpi
 
 pytestmark = needs_mpi
 BENCH = os.path.join(ROOT, "scripts", "tools", "mpi_bench.py")
-CELLS = ["40", "40", "96"]   # 3D, 1.2 M particles: a few hundred MB on 1 process
+CELLS = ["48", "48", "128"]   # 3D, 2.4 M particles: ≈ 0.8 GB of address space on 1 process, ≈ 0.5 GB per rank on 4
 
 
 def _run(limit_kb, ranks):

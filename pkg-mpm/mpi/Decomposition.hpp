@@ -4,6 +4,7 @@
 // (HaloExchange), the Δt limits are global, and a phase that failed on one rank stops every rank.
 #pragma once
 #include "HaloExchange.hpp"
+#include <malloc.h>
 
 #ifdef MPM_MPI
 namespace mpm {
@@ -35,6 +36,7 @@ public:
 		int lo, hi;
 		layout.reachedLayers(g, rank, lo, hi);
 		g.setWindow(lo, hi + 1);
+		malloc_trim(0); // the whole grid's arrays go back to the system
 		building = true;
 	}
 	// Distributed construction: appends of the n particles at x (x[p·D + a]) those of this rank's slab, with the
@@ -159,34 +161,54 @@ public:
 	// whether any particle on any rank moved.
 	bool hop(Grid<D>& g, Particles<D>& P, bool strict)
 	{
-		std::vector<uint8_t> go(P.n, 0); // 0: stays, 1: to rank − 1, 2: to rank + 1
-		bool                 ok = true;
-		size_t               nd = 0, nu = 0;
-		for (size_t p = 0; p < P.n; ++p) {
-			const int o = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p]));
-			if (o == rank) continue;
-			ok = ok && (o == rank - 1 || o == rank + 1);
-			go[p] = o < rank ? 1 : 2;
-			(o < rank ? nd : nu) += 1;
-		}
+		std::vector<uint8_t> go;
+		bool                 ok, more;
+		size_t               nd, nu;
+		mark(g, P, go, ok, nd, nu, more);
 		if (strict && !Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
 		if (!strict && Comm::all(nd + nu == 0)) return false;
 		double opt[3] = { double(P.hasTraction()), double(P.hasDamageState()), double(!P.nFlaw.empty()) };
 		Comm::max(opt, 3); // the optional fields some rank holds: every rank sends and receives them (zero where absent)
 		ensureFields(P, opt);
 		const size_t nf = size_t(2 + 2 * D + D * D + 3 + Particles<D>::NS) + size_t(opt[0] > 0) * D + size_t(opt[1] > 0) * 3 + size_t(opt[2] > 0);
-		std::vector<double> sd, su, rd(1), ru(1), cd { double(nd) }, cu { double(nu) };
-		Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
-		const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
-		sd.reserve(nd * nf), su.reserve(nu * nf);
-		for (size_t p = 0; p < P.n; ++p)
-			if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
-		rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
-		Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
-		keep(P, go);
-		unpack(P, rd, ad, nf, opt), unpack(P, ru, au, nf, opt); // arrivals from below, then from above: a fixed order
-		migrated += nd + nu;
-		return true;
+		std::vector<double> sd, su, rd, ru;
+		while (true) { // rounds of at most `batch` particles per direction (one round unless many move)
+			std::vector<double> cd { double(nd) }, cu { double(nu) };
+			rd.assign(1, 0.0), ru.assign(1, 0.0);
+			Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
+			const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
+			sd.clear(), su.clear(), sd.reserve(nd * nf), su.reserve(nu * nf);
+			for (size_t p = 0; p < P.n; ++p)
+				if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
+			rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
+			Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
+			keep(P, go);
+			unpack(P, rd, ad, nf, opt), unpack(P, ru, au, nf, opt); // arrivals from below, then from above: a fixed order
+			migrated += nd + nu;
+			if (Comm::all(!more)) return true;
+			mark(g, P, go, ok, nd, nu, more);
+		}
+	}
+	// Migration in rounds of at most `batch` particles per direction: the send and receive buffers stay bounded
+	// (≈ 15 MB in 3D) when a re-cut moves a large part of a rank's particles (distributed construction).
+	static constexpr size_t batch = size_t(1) << 16;
+	// go[p]: 0 stays, 1 to rank − 1, 2 to rank + 1, for at most `batch` particles per direction (nd, nu: marked;
+	// more: some were left for another round); ok: every mover belongs to a neighbour.
+	void mark(const Grid<D>& g, const Particles<D>& P, std::vector<uint8_t>& go, bool& ok, size_t& nd, size_t& nu, bool& more) const
+	{
+		go.assign(P.n, 0);
+		ok = true, more = false, nd = nu = 0;
+		for (size_t p = 0; p < P.n; ++p) {
+			const int o = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p]));
+			if (o == rank) continue;
+			ok          = ok && (o == rank - 1 || o == rank + 1);
+			size_t& cnt = o < rank ? nd : nu;
+			if (cnt == batch) {
+				more = true;
+				continue;
+			}
+			go[p] = o < rank ? 1 : 2, ++cnt;
+		}
 	}
 
 	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.
@@ -280,6 +302,7 @@ private:
 		ownedHi = rank + 1 == R ? g.globalSize() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
 		ownedLo -= g.offset, ownedHi -= g.offset; // local indices
 		decomposed = true;
+		malloc_trim(0); // freed arrays (the old window, dropped particles, migration buffers) go back to the system
 	}
 	// This rank's particle count per block layer along the slab axis (the input of SlabLayout::balanced).
 	static std::vector<double> layerCounts(const Grid<D>& g, const Particles<D>& P)
