@@ -36,7 +36,8 @@ public:
 		int lo, hi;
 		layout.reachedLayers(g, rank, lo, hi);
 		g.setWindow(lo, hi + 1);
-		malloc_trim(0); // the whole grid's arrays go back to the system
+		malloc_trim(0);                        // the whole grid's arrays go back to the system
+		mallopt(M_MMAP_THRESHOLD, 1 << 20); // fixed: arrays ≥ 1 MB are mapped and go back when freed (no heap high-water)
 		building = true;
 	}
 	// Distributed construction: appends of the n particles at x (x[p·D + a]) those of this rank's slab, with the
