@@ -18,7 +18,7 @@ TOPICS = {
                 "test_checkpoint", "test_hybrid", "test_yade_hook", "test_examples", "test_pic_dissipation"],
     "paper": ["test_bonded", "test_case_results", "test_circular_opening", "test_fidelity", "test_penny_crack", "test_penny_prism",
               "test_report", "test_scripts_smoke", "test_slab3d", "test_stability", "test_studies", "test_tunnel", "test_tunnel_script"],
-    "mpi": ["test_mpi", "test_mpi_checkpoint", "test_mpi_contact", "test_mpi_outside", "test_mpi_rebalance", "test_mpi_spheres"],
+    "mpi": ["test_mpi", "test_mpi_checkpoint", "test_mpi_contact", "test_mpi_outside", "test_mpi_rebalance", "test_mpi_spheres", "test_mpi_distributed", "test_mpi_memory"],
 }
 SLOW = {"test_contact_matrix", "test_studies", "test_contact_params", "test_scripts_smoke", "test_contact_kinematic",
         "test_contact_corners", "test_tunnel_script", "test_mpi_contact", "test_slab3d", "test_mpi_spheres", "test_circular_opening",

@@ -58,6 +58,7 @@ res["time"] = np.array([s.time])
 info = s.mpiInfo() if hasattr(s, "mpiInfo") else {"rank": 0, "size": 1, "migrated": 0, "firstLayers": []}
 res["rank"], res["size"], res["migrated"] = info["rank"], info["size"], info["migrated"]
 res["first"] = np.array(info["firstLayers"])
+res["gridNodes"] = len(s._nodePositions())   # the node layers this rank holds (its window under MPI)
 res["y0"] = y0
 res["vtk"] = ym.output.VtuSeries(out + "_vtk").write(s)   # under MPI: a piece per rank and a .pvtu
 np.savez(f"{out}.{info['rank']}.npz", **res)
@@ -145,6 +146,10 @@ def test_two_ranks_match_one(tmp_path, dim):
     for k, p in enumerate(parts):
         now = layer(p[f"x{d}"])
         assert np.all((now >= first[k] - 1) & (now <= first[k + 1])), "particles far outside their rank's slab"
+    # each rank holds only the node layers of its slab and halo (the grid is distributed too)
+    total = int(ref[0]["gridNodes"])
+    assert all(int(p["gridNodes"]) < 0.8 * total for p in parts), (total, [int(p["gridNodes"]) for p in parts])
+    assert sum(int(p["gridNodes"]) for p in parts) < 1.5 * total
     # the material moved and is stressed: the comparison is not trivial
     assert np.max(np.abs(one["sig1"])) > 1e5
     rel = _max_rel(one, two)

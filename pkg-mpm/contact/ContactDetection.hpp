@@ -79,7 +79,8 @@ public:
 		if (nodeArr.size() != grid.size()) nodeArr.resize(grid.size()), marked.reserve(4096);
 		work.resize(groups.size());
 		dq.resize(parts.size());
-		for (size_t i : marked) grid.setBits(i, ExContact, false);
+		for (size_t gi : marked) // global indices: the grid's window may have moved since (MPI, Grid::setWindow)
+			if (gi >= grid.offset && gi - grid.offset < grid.size()) grid.setBits(gi - grid.offset, ExContact, false);
 		marked.clear();
 		for (auto& q : parts) q.force.setZero(), q.torque.setZero();
 		const Real l    = grid.spacing;
@@ -107,7 +108,7 @@ public:
 					Real d = g.query(grid.position(i)).d;
 					if (d < 0 && d > -band) {
 						grid.setBits(i, ExContact, true);
-						marked.push_back(i);
+						marked.push_back(i + grid.offset);
 					}
 				});
 			// particles that may touch, and the nodes their stencils reach; a distributed run decides from the
@@ -130,7 +131,7 @@ public:
 	}
 
 private:
-	std::vector<size_t> marked; // nodes carrying the contact exclusion bit
+	std::vector<size_t> marked; // nodes carrying the contact exclusion bit (global indices)
 };
 
 } // namespace mpm

@@ -4,6 +4,7 @@
 #pragma once
 #include "MirrorPlanes.hpp"
 #include <algorithm>
+#include <set>
 #include <vector>
 
 namespace mpm {
@@ -49,6 +50,10 @@ struct Grid {
 	std::vector<uint8_t> stencilExcl; // excluded nodes in the 4^D stencil starting at this node (one load per kernel)
 	std::vector<BoundaryPlane<D>> planes;
 	Vec allowedLo, allowedHi; // particles must stay in [allowedLo, allowedHi): the physical grid cut by the planes
+	// The node arrays hold the stored layers [layer0, layerEnd) along the last axis (the whole grid unless an MPI rank
+	// narrowed it to its slab, setWindow): a node index is local, the global index minus offset = layer0 · stride.
+	int    layer0 = 0, layerEnd = 0;
+	size_t offset = 0;
 
 	MirrorPlanes<D> mirrors; // the Slip planes (fold/unfold of the reflected images)
 
@@ -72,17 +77,44 @@ struct Grid {
 			s *= stored[a];
 		}
 		for (int a = D; a < 3; ++a) stride[a] = 0;
-		nodes.assign(s, Node<D> {});
-		vel.assign(s, NodeVec<D> {}), vold.assign(s, NodeVec<D> {}), mom.assign(s, NodeVec<D> {}), vmusl.assign(s, NodeVec<D> {});
-		fixMask.assign(s, 0);
+		layer0 = 0, layerEnd = int(stored[D - 1]), offset = 0;
+		allocate(s);
 		excluded.assign(s, 0);
+		gapNodes.clear();
 		planes.clear();
 		rebuildPlanes();
 	}
 	size_t size() const { return nodes.size(); }
-	// Stored (ghost-shifted) integer coordinates of linear index i.
+	size_t globalSize() const { return stride[D - 1] * size_t(stored[D - 1]); }
+	bool   inWindow(const IVec& c) const { return c[D - 1] >= layer0 && c[D - 1] < layerEnd; }
+	// Keeps only the stored layers [lo, hi) along the last axis (MPI: a rank's slab and halo, mpi/Decomposition.hpp):
+	// the node arrays are re-allocated; exclusion bits of gaps and of rigid-body contact are kept, the rest rebuilt.
+	void setWindow(int lo, int hi)
+	{
+		lo = std::max(lo, 0), hi = std::min(hi, int(stored[D - 1]));
+		if (lo == layer0 && hi == layerEnd) return;
+		if (!(lo < hi)) throw InputError("grid window: empty layer range [" + std::to_string(lo) + ", " + std::to_string(hi) + ")");
+		const size_t st = stride[D - 1], s = size_t(hi - lo) * st, off = size_t(lo) * st;
+		std::vector<uint8_t> ex(s, 0);
+		const int a0 = std::max(lo, layer0), a1 = std::min(hi, layerEnd); // overlap: contact bits carry over
+		for (int k = a0; k < a1; ++k)
+			for (size_t j = 0; j < st; ++j) ex[size_t(k - lo) * st + j] = excluded[size_t(k - layer0) * st + j] & ExContact;
+		for (size_t gi : gapNodes)
+			if (gi >= off && gi < off + s) ex[gi - off] |= ExGap;
+		layer0 = lo, layerEnd = hi, offset = off;
+		excluded = std::move(ex);
+		allocate(s);
+		rebuildPlanes();
+	}
+	// Bytes held by the node arrays of this process (the window).
+	size_t bytes() const
+	{
+		return size() * (sizeof(Node<D>) + 4 * sizeof(NodeVec<D>) + 3) + gapNodes.size() * 48; // a set entry ≈ 48 B
+	}
+	// Stored (ghost-shifted) integer coordinates of (local) node index i.
 	IVec coords(size_t i) const
 	{
+		i += offset;
 		IVec c;
 		for (int a = 0; a < D; ++a) {
 			c[a] = int(i % stored[a]);
@@ -110,7 +142,7 @@ struct Grid {
 	{
 		size_t k = 0;
 		for (int a = 0; a < D; ++a) k += size_t(storedCoords[a]) * stride[a];
-		return k;
+		return k - offset;
 	}
 	// Upper corner of the physical grid.
 	Vec upper() const
@@ -186,7 +218,7 @@ struct Grid {
 		// images of symmetry planes carry their partner's gap/contact bits
 		for (size_t i = 0; i < s; ++i) {
 			size_t src = partnerOf(i);
-			if (src != i) excluded[i] = (excluded[i] & uint8_t(ExGhost | ExBeyond)) | (excluded[src] & uint8_t(~(ExGhost | ExBeyond)));
+			if (src != i && src < s) excluded[i] = (excluded[i] & uint8_t(ExGhost | ExBeyond)) | (excluded[src] & uint8_t(~(ExGhost | ExBeyond)));
 		}
 		recountStencils();
 	}
@@ -205,6 +237,8 @@ struct Grid {
 		if (i >= size()) throw InputError("node index " + std::to_string(i) + " is outside [0, " + std::to_string(size() - 1) + "]");
 		if (isGhost(i)) throw InputError("node index " + std::to_string(i) + " is a ghost node outside the physical grid");
 		setBits(i, ExGap, ex);
+		if (ex) gapNodes.insert(i + offset); // kept for a later setWindow
+		else gapNodes.erase(i + offset);
 	}
 
 	// ------------------------------------------------------------------ symmetry planes (MirrorPlanes.hpp)
@@ -225,6 +259,12 @@ struct Grid {
 	}
 
 private:
+	void allocate(size_t s)
+	{
+		nodes.assign(s, Node<D> {});
+		vel.assign(s, NodeVec<D> {}), vold.assign(s, NodeVec<D> {}), mom.assign(s, NodeVec<D> {}), vmusl.assign(s, NodeVec<D> {});
+		fixMask.assign(s, 0);
+	}
 	static std::string num(Real v)
 	{
 		char b[32];
@@ -232,12 +272,15 @@ private:
 		return b;
 	}
 	// The node whose content node i mirrors (i itself when i is not an image).
-	size_t partnerOf(size_t i) const { return mirrors.empty() ? i : linear(mirrors.partner(coords(i))); }
+	size_t partnerOf(size_t i) const { return mirrors.empty() ? i : linear(mirrors.partner(coords(i))); } // may lie outside the window (≥ size())
+	std::set<size_t> gapNodes; // global indices of the nodes with ExGap (setExcluded)
 	// Node i and all its images across the symmetry planes (corners included).
 	template <class F>
 	void forImages(size_t i, F&& f) const
 	{
-		mirrors.forImages(coords(i), [&](const IVec& c) { f(linear(c)); });
+		mirrors.forImages(coords(i), [&](const IVec& c) {
+			if (inWindow(c)) f(linear(c));
+		});
 	}
 	void writeBits(size_t i, uint8_t bits, bool on)
 	{
@@ -251,7 +294,7 @@ private:
 			bool ok = true;
 			for (int a = 0; a < D; ++a) {
 				b[a] = c[a] - ((n >> (2 * a)) & 3);
-				ok   = ok && b[a] >= 0 && b[a] + 3 < stored[a];
+				ok   = ok && b[a] >= (a == D - 1 ? layer0 : 0) && b[a] + 3 < (a == D - 1 ? layerEnd : stored[a]);
 			}
 			if (!ok) continue;
 			auto& cnt = stencilExcl[linear(b)];
@@ -268,7 +311,7 @@ private:
 			for (size_t i = 0; i < s; ++i) {
 				const int k = coords(i)[a];
 				uint8_t   t = 0;
-				if (k + 3 < stored[a])
+				if (k + 3 < (a == D - 1 ? layerEnd : stored[a]))
 					for (int j = 0; j < 4; ++j) t += in[i + size_t(j) * stride[a]];
 				out[i] = t;
 			}

@@ -21,6 +21,10 @@ struct GridBoxes {
 			nlo[a] = int(std::ceil(fl)) + gh, nhi[a] = int(std::floor(fh)) + gh;
 			if (nlo[a] > nhi[a]) return false;
 		}
+		// a grid holding a window of layers (MPI rank, Grid::setWindow): the box clipped to it, possibly empty
+		// (nhi < nlo: boxCount 0) but still true, so every rank takes the same decisions
+		nlo[D - 1] = std::max(nlo[D - 1], grid.layer0), nhi[D - 1] = std::min(nhi[D - 1], grid.layerEnd - 1);
+		if (nhi[D - 1] < nlo[D - 1]) nhi[D - 1] = nlo[D - 1] - 1;
 		return true;
 	}
 	// Block coordinates whose particles may lie within [lo, hi]; false when the box misses the grid.
@@ -65,12 +69,13 @@ struct GridBoxes {
 	template <class F>
 	static void forNodes(const Grid<D>& grid, const IVec& lo, const IVec& hi, F&& f)
 	{
+		if (!boxCount(lo, hi)) return;
 		forBox(lo, hi, [&](const IVec& c) { f(grid.linear(c)); });
 	}
 	static size_t boxCount(const IVec& lo, const IVec& hi)
 	{
 		size_t n = 1;
-		for (int a = 0; a < D; ++a) n *= size_t(hi[a] - lo[a] + 1);
+		for (int a = 0; a < D; ++a) n *= size_t(std::max(hi[a] - lo[a] + 1, 0));
 		return n;
 	}
 	static size_t boxNode(const Grid<D>& grid, const IVec& lo, const IVec& hi, size_t j)
@@ -81,7 +86,7 @@ struct GridBoxes {
 			i += size_t(lo[a] + int(j % w)) * grid.stride[a];
 			j /= w;
 		}
-		return i;
+		return i - grid.offset;
 	}
 };
 

@@ -34,11 +34,14 @@ public:
 		m.axis = axis, m.side = side, m.twoP = twoP;
 		m.stride = g.stride[axis], m.nStored = g.stored[axis];
 		m.physLo = G::ghost, m.physHi = g.cells[axis] + G::ghost;
+		// the grid may hold a window of layers along the last axis (Grid::setWindow): a column's index is that of
+		// coordinate 0 (wrapping size_t arithmetic), and only pairs inside the window are kept
+		const int kLo = axis == D - 1 ? g.layer0 : 0, kHi = axis == D - 1 ? g.layerEnd : m.nStored;
 		for (size_t i = 0; i < g.size(); ++i)
-			if (g.coords(i)[axis] == 0) m.columns.push_back(i);
-		for (int k = 0; k < m.nStored; ++k) {
+			if (g.coords(i)[axis] == kLo) m.columns.push_back(i - size_t(kLo) * m.stride);
+		for (int k = kLo; k < kHi; ++k) {
 			const int d2 = -side * (2 * k - twoP), kp = twoP - k; // ≥ 0 on the material side (half cells)
-			if (d2 >= 0 && d2 < 4 && kp >= 0 && kp < m.nStored && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
+			if (d2 >= 0 && d2 < 4 && kp >= kLo && kp < kHi && m.nPairs < 3) m.pairK[m.nPairs] = k, m.pairKp[m.nPairs++] = kp;
 		}
 		list.push_back(std::move(m));
 		const Mirror& added = list.back();
@@ -58,8 +61,8 @@ public:
 			const long    nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				E* col = &nodes[m.columns[size_t(c)]];
-				for (int e = 0; e < g.n; ++e) lanes(col[size_t(g.k[e]) * m.stride]) += sg * lanes(col[size_t(g.kp[e]) * m.stride]);
+				const size_t col = m.columns[size_t(c)];
+				for (int e = 0; e < g.n; ++e) lanes(nodes[col + size_t(g.k[e]) * m.stride]) += sg * lanes(nodes[col + size_t(g.kp[e]) * m.stride]);
 			}
 		}
 	}
@@ -74,9 +77,9 @@ public:
 			const long    nc = long(m.columns.size());
 #pragma omp for schedule(static)
 			for (long c = 0; c < nc; ++c) {
-				E* col = &nodes[m.columns[size_t(c)]];
+				const size_t col = m.columns[size_t(c)];
 				for (int e = g.n - 1; e >= 0; --e)
-					if (g.k[e] != g.kp[e]) lanes(col[size_t(g.kp[e]) * m.stride]) = sg * lanes(col[size_t(g.k[e]) * m.stride]);
+					if (g.k[e] != g.kp[e]) lanes(nodes[col + size_t(g.kp[e]) * m.stride]) = sg * lanes(nodes[col + size_t(g.k[e]) * m.stride]);
 			}
 		}
 	}

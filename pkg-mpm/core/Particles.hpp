@@ -47,6 +47,12 @@ struct Particles {
 		forEachRealField([&](std::vector<Real>& f) { f.reserve(total); });
 		id.reserve(total), mat.reserve(total);
 	}
+	// Gives back the memory beyond n particles in every array (after an MPI rank dropped the others' particles).
+	void shrink()
+	{
+		forEachRealField([&](std::vector<Real>& f) { f.shrink_to_fit(); });
+		id.shrink_to_fit(), mat.shrink_to_fit();
+	}
 	// True if n more particles fit into every allocated array without moving it.
 	bool fits(size_t more) const
 	{

@@ -63,8 +63,10 @@ struct KernelGeom {
 	Real           origin[D], cells[D]; // [m], physical cells per axis
 	Real           h, invH, gradFactor;  // l [m], 1/l, 3/l² (interior M⁻¹ gradient factor, ∇ψ_i = w_i 3/l² (x_i − x_p))
 	size_t         stride[D];
+	size_t         offset; // global index of the grid's first held node (Grid::setWindow)
 	const uint8_t* stencilExcl;
-	explicit KernelGeom(const Grid<D>& g) : h(g.spacing), invH(1.0 / g.spacing), gradFactor(3.0 / (g.spacing * g.spacing)), stencilExcl(g.stencilExcl.data())
+	explicit KernelGeom(const Grid<D>& g)
+	    : h(g.spacing), invH(1.0 / g.spacing), gradFactor(3.0 / (g.spacing * g.spacing)), offset(g.offset), stencilExcl(g.stencilExcl.data())
 	{
 		for (int a = 0; a < D; ++a) origin[a] = g.origin[a], cells[a] = g.cells[a], stride[a] = g.stride[a];
 	}
@@ -96,8 +98,8 @@ inline void computeKernel(const KernelGeom<D>& g, const Real* x, Kernel<D>& k)
 		k.d[a] = (jm - t) * h;
 		base += size_t(c - 1 + Grid<D>::ghost) * g.stride[a];
 	}
-	k.base    = base;
-	k.general = g.stencilExcl[base] != 0; // one load: ghosts near the grid edge, planes, gaps, contact
+	k.base    = base - g.offset; // local index: a rank's particles reach only its window
+	k.general = g.stencilExcl[k.base] != 0; // one load: ghosts near the grid edge, planes, gaps, contact
 }
 
 // Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit

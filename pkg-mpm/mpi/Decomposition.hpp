@@ -4,6 +4,7 @@
 // (HaloExchange), the Δt limits are global, and a phase that failed on one rank stops every rank.
 #pragma once
 #include "HaloExchange.hpp"
+#include <malloc.h>
 
 #ifdef MPM_MPI
 namespace mpm {
@@ -17,7 +18,50 @@ public:
 	bool            decomposed = false;
 	size_t          migrated   = 0; // particles sent by this rank since the split
 
+	bool   building = false; // distributed construction (distribute): this rank keeps only its slab's particles
+	size_t builtIds = 0;     // particles added over all ranks so far under distributed construction: the next global id
+
 	bool distributed() const { return R > 1; }
+	// Distributed construction, before any particle exists: the slabs start evenly (block layers split by
+	// count, SlabLayout::even), the grid keeps this rank's window of them, and every later addParticles keeps
+	// only the particles of this rank's slab (clip), with the global running index as id (the ids of 1 process).
+	// The first step re-cuts by the particle counts (the start rule) and moves particles to their owners.
+	void distribute(Grid<D>& g, size_t particles)
+	{
+		if (!distributed() || building) return;
+		if (decomposed) throw InputError("mpiDistribute: the solver has stepped already; call it right after creating the solver");
+		if (particles)
+			throw InputError("mpiDistribute: this rank holds " + std::to_string(particles) + " particles already; call it before adding particles");
+		layout = SlabLayout<D>::balanced(std::vector<double>(size_t(SlabLayout<D>::layers(g)), 1.0), R); // even: one per layer
+		int lo, hi;
+		layout.reachedLayers(g, rank, lo, hi);
+		g.setWindow(lo, hi + 1);
+		malloc_trim(0);                        // the whole grid's arrays go back to the system
+		mallopt(M_MMAP_THRESHOLD, 1 << 20); // fixed: arrays ≥ 1 MB are mapped and go back when freed (no heap high-water)
+		building = true;
+	}
+	// Distributed construction: appends of the n particles at x (x[p·D + a]) those of this rank's slab, with the
+	// global running index as id (a non-finite coordinate stays on rank 0, whose check names it). False if none.
+	bool appendOwn(const Grid<D>& g, Particles<D>& P, const Real* x, const Real* vol, const Real* mass, size_t n, uint8_t material)
+	{
+		std::vector<size_t> kept;
+		for (size_t p = 0; p < n; ++p) {
+			const Real z = x[p * D + D - 1];
+			if (std::isfinite(z) ? layout.owner(SlabLayout<D>::layerOf(g, z)) == rank : rank == 0) kept.push_back(p);
+		}
+		const size_t old = P.n, first = builtIds;
+		builtIds += n;
+		if (kept.empty()) return false;
+		std::vector<Real> xk(kept.size() * D), vk(kept.size()), mk(kept.size());
+		for (size_t k = 0; k < kept.size(); ++k) {
+			for (int a = 0; a < D; ++a) xk[k * D + a] = x[kept[k] * D + a];
+			vk[k] = vol[kept[k]], mk[k] = mass[kept[k]];
+		}
+		P.reserve(P.n + kept.size()); // exact growth: a doubling vector would hold up to 2× the rank's particles
+		P.append(xk.data(), vk.data(), mk.data(), kept.size(), g.origin, g.upper(), material);
+		for (size_t k = 0; k < kept.size(); ++k) P.id[old + k] = int64_t(first + kept[k]); // the id of 1 process
+		return true;
+	}
 	bool needsSplit() const { return R > 1 && !decomposed; } // the first step on > 1 rank always sorts (and splits)
 
 	// Refuses, before any work, what this build does not distribute yet (the same answer on every rank).
@@ -32,13 +76,16 @@ public:
 	// What needs the whole scene on every rank is refused once the ranks hold their own particles.
 	void refuseAfterSplit(const char* what) const
 	{
+		if (building && !decomposed && std::string(what).rfind("addParticles", 0) != 0)
+			throw InputError(std::string("MPI: ") + what + " is not supported under distributed construction (yade_mpm.parallel.distribute): each rank "
+			                 "holds only its slab's particles; build the scene without distribute");
 		if (decomposed)
 			throw InputError(std::string("MPI: ") + what + " after the first step is not supported on " + std::to_string(R)
 			                 + " ranks: each rank holds only its slab's particles now (doc/scaling.md)");
 	}
 	// Checkpoint resume (py/yade_mpm/checkpoint.py) into the freshly built, replicated scene: the saved slab
 	// layout, and the particle arrays cut to the rank's saved count n (the caller then writes the saved values).
-	void restore(const Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n)
+	void restore(Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n)
 	{
 		if (decomposed) throw InputError("MPI checkpoint resume: the solver has stepped already; load the checkpoint into the freshly built scene");
 		if (int(first.size()) != R + 1)
@@ -58,7 +105,7 @@ public:
 	}
 	// Before the counting sort: the first call splits the (replicated) scene, later calls re-balance (when the
 	// busiest rank holds more than `threshold` × the mean particle count) and migrate.
-	void migrate(const Grid<D>& g, Particles<D>& P, Real threshold)
+	void migrate(Grid<D>& g, Particles<D>& P, Real threshold)
 	{
 		if (!distributed()) return;
 		if (!decomposed) return split(g, P);
@@ -79,7 +126,7 @@ public:
 	// doubles); when max/mean of the per-rank counts exceeds the threshold (inf: never), the slabs are cut
 	// again by the start rule (SlabLayout::balanced). A new cut that would put a
 	// symmetry plane across a slab boundary is not taken (the same answer on every rank). True if re-cut.
-	bool rebalance(const Grid<D>& g, const Particles<D>& P, Real threshold)
+	bool rebalance(Grid<D>& g, const Particles<D>& P, Real threshold)
 	{
 		std::vector<double> count = layerCounts(g, P);
 		Comm::sum(count.data(), int(count.size()));
@@ -113,33 +160,56 @@ public:
 	// One migration pass: particles whose block layer belongs to another rank move one rank towards it.
 	// strict: a particle must not be more than one slab away (no re-cut since the last re-sort). Returns
 	// whether any particle on any rank moved.
-	bool hop(const Grid<D>& g, Particles<D>& P, bool strict)
+	bool hop(Grid<D>& g, Particles<D>& P, bool strict)
 	{
-		std::vector<uint8_t> go(P.n, 0); // 0: stays, 1: to rank − 1, 2: to rank + 1
-		bool                 ok = true;
-		size_t               nd = 0, nu = 0;
+		std::vector<uint8_t> go;
+		bool                 ok, more;
+		size_t               nd, nu;
+		mark(g, P, go, ok, nd, nu, more);
+		if (strict && !Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
+		if (!strict && Comm::all(nd + nu == 0)) return false;
+		double opt[3] = { double(P.hasTraction()), double(P.hasDamageState()), double(!P.nFlaw.empty()) };
+		Comm::max(opt, 3); // the optional fields some rank holds: every rank sends and receives them (zero where absent)
+		ensureFields(P, opt);
+		const size_t nf = size_t(2 + 2 * D + D * D + 3 + Particles<D>::NS) + size_t(opt[0] > 0) * D + size_t(opt[1] > 0) * 3 + size_t(opt[2] > 0);
+		std::vector<double> sd, su, rd, ru;
+		while (true) { // rounds of at most `batch` particles per direction (one round unless many move)
+			std::vector<double> cd { double(nd) }, cu { double(nu) };
+			rd.assign(1, 0.0), ru.assign(1, 0.0);
+			Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
+			const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
+			sd.clear(), su.clear(), sd.reserve(nd * nf), su.reserve(nu * nf);
+			for (size_t p = 0; p < P.n; ++p)
+				if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
+			rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
+			Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
+			keep(P, go);
+			unpack(P, rd, ad, nf, opt), unpack(P, ru, au, nf, opt); // arrivals from below, then from above: a fixed order
+			migrated += nd + nu;
+			if (Comm::all(!more)) return true;
+			mark(g, P, go, ok, nd, nu, more);
+		}
+	}
+	// Migration in rounds of at most `batch` particles per direction: the send and receive buffers stay bounded
+	// (≈ 15 MB in 3D) when a re-cut moves a large part of a rank's particles (distributed construction).
+	static constexpr size_t batch = size_t(1) << 16;
+	// go[p]: 0 stays, 1 to rank − 1, 2 to rank + 1, for at most `batch` particles per direction (nd, nu: marked;
+	// more: some were left for another round); ok: every mover belongs to a neighbour.
+	void mark(const Grid<D>& g, const Particles<D>& P, std::vector<uint8_t>& go, bool& ok, size_t& nd, size_t& nu, bool& more) const
+	{
+		go.assign(P.n, 0);
+		ok = true, more = false, nd = nu = 0;
 		for (size_t p = 0; p < P.n; ++p) {
 			const int o = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p]));
 			if (o == rank) continue;
-			ok = ok && (o == rank - 1 || o == rank + 1);
-			go[p] = o < rank ? 1 : 2;
-			(o < rank ? nd : nu) += 1;
+			ok          = ok && (o == rank - 1 || o == rank + 1);
+			size_t& cnt = o < rank ? nd : nu;
+			if (cnt == batch) {
+				more = true;
+				continue;
+			}
+			go[p] = o < rank ? 1 : 2, ++cnt;
 		}
-		if (strict && !Comm::all(ok)) throw SimulationError("MPI: a particle moved past a neighbouring rank's slab between two re-sorts (lower sortPeriod)");
-		if (!strict && Comm::all(nd + nu == 0)) return false;
-		const size_t nf = fieldCount(P);
-		std::vector<double> sd, su, rd(1), ru(1), cd { double(nd) }, cu { double(nu) };
-		Comm::neighbours(rank - 1, rank + 1, cd, rd, cu, ru); // counts first
-		const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
-		sd.reserve(nd * nf), su.reserve(nu * nf);
-		for (size_t p = 0; p < P.n; ++p)
-			if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
-		rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
-		Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
-		keep(P, go);
-		unpack(P, rd, ad, nf), unpack(P, ru, au, nf); // arrivals from below, then from above: a fixed order
-		migrated += nd + nu;
-		return true;
 	}
 
 	// Global limits for Δt and the mass floor (Solver::prepare); empty ranks contribute ±inf / 0.
@@ -191,8 +261,20 @@ public:
 private:
 	// First step: the same particles on every rank (checked: count and a position checksum); slabs from
 	// the particle counts per block layer; each rank keeps its own.
-	void split(const Grid<D>& g, Particles<D>& P)
+	void split(Grid<D>& g, Particles<D>& P)
 	{
+		if (building) { // each rank holds its slab of the even start layout: re-cut by the global counts, move
+			std::vector<double> count = layerCounts(g, P);
+			Comm::sum(count.data(), int(count.size()));
+			SlabLayout<D> cut = SlabLayout<D>::balanced(count, R);
+			cut.checkMirrors(g);
+			layout = cut;
+			for (int pass = 0; pass < R - 1; ++pass)
+				if (!hop(g, P, false)) break;
+			P.shrink();
+			settle(g);
+			return;
+		}
 		double s = 0;
 		for (size_t p = 0; p < P.n; ++p) s += P.x[D - 1][p] + 0.5 * P.x[0][p] + 1e-3 * double(P.id[p]);
 		double hiv[3] = { double(P.n), s, double(fieldCount(P)) }, lov[3] = { -hiv[0], -hiv[1], -hiv[2] };
@@ -205,15 +287,23 @@ private:
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
 		keep(P, go);
+		P.shrink(); // the other ranks' particles: their memory goes back
 		settle(g);
 	}
-	void settle(const Grid<D>& g)
+	// The layout in force: the grid keeps the node layers this rank's particles reach (its window, re-allocated
+	// when the cut moved) and the nodes it counts in sums over nodes.
+	void settle(Grid<D>& g)
 	{
 		const int    ax = D - 1, B = SlabLayout<D>::B, gh = Grid<D>::ghost;
 		const size_t st = g.stride[ax];
-		ownedLo = rank == 0 ? 0 : size_t(layout.first[size_t(rank)] * B + gh) * st;
-		ownedHi = rank + 1 == R ? g.size() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
+		int          lo, hi;
+		layout.reachedLayers(g, rank, lo, hi);
+		g.setWindow(lo, hi + 1);
+		ownedLo = rank == 0 ? g.offset : size_t(layout.first[size_t(rank)] * B + gh) * st;
+		ownedHi = rank + 1 == R ? g.globalSize() : size_t(layout.first[size_t(rank) + 1] * B + gh) * st;
+		ownedLo -= g.offset, ownedHi -= g.offset; // local indices
 		decomposed = true;
+		malloc_trim(0); // freed arrays (the old window, dropped particles, migration buffers) go back to the system
 	}
 	// This rank's particle count per block layer along the slab axis (the input of SlabLayout::balanced).
 	static std::vector<double> layerCounts(const Grid<D>& g, const Particles<D>& P)
@@ -251,18 +341,28 @@ private:
 		compact(P.id), compact(P.mat);
 		P.n = k;
 	}
-	static void unpack(Particles<D>& P, const std::vector<double>& buf, size_t count, size_t nf)
+	// The optional fields flagged in opt (traction, damage state, flaw counts), zero-filled where missing.
+	static void ensureFields(Particles<D>& P, const double* opt)
+	{
+		if (opt[0] > 0 && !P.hasTraction())
+			for (int a = 0; a < D; ++a) P.trac[a].assign(P.n, 0.0);
+		if (opt[1] > 0 && !P.hasDamageState())
+			for (auto* f : { &P.epsP, &P.damage, &P.eps0 }) f->assign(P.n, 0.0);
+		if (opt[2] > 0 && P.nFlaw.empty()) P.nFlaw.assign(P.n, 0.0);
+	}
+	static void unpack(Particles<D>& P, const std::vector<double>& buf, size_t count, size_t nf, const double* opt)
 	{
 		if (!count) return;
 		const size_t n0 = P.n;
 		P.n += count;
+		ensureFields(P, opt); // a rank without particles had none of them (empty arrays)
 		size_t i = 0; // field index, in pack's order
 		P.forEachRealField([&](std::vector<Real>& f) {
-			f.resize(P.n);
+			f.reserve(P.n), f.resize(P.n); // exact growth (no doubling)
 			for (size_t j = 0; j < count; ++j) f[n0 + j] = buf[j * nf + i];
 			++i;
 		});
-		P.id.resize(P.n), P.mat.resize(P.n);
+		P.id.reserve(P.n), P.mat.reserve(P.n), P.id.resize(P.n), P.mat.resize(P.n);
 		for (size_t j = 0; j < count; ++j) {
 			std::memcpy(&P.id[n0 + j], &buf[j * nf + i], sizeof(int64_t));
 			P.mat[n0 + j] = uint8_t(buf[j * nf + i + 1]);

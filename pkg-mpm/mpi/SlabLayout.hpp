@@ -61,10 +61,10 @@ struct SlabLayout {
 		lo = first[size_t(r)] * B - margin - 1 + ghost;
 		hi = std::min(first[size_t(r)] * B + margin + 1 + ghost, int(g.stored[axis]) - 1);
 	}
-	// Node index range [i0, i1) of stored layers [lo, hi].
+	// Local node index range [i0, i1) of stored layers [lo, hi] (inside the grid's window, Grid::setWindow).
 	static void nodeRange(const Grid<D>& g, int lo, int hi, size_t& i0, size_t& i1)
 	{
-		i0 = size_t(lo) * g.stride[axis], i1 = size_t(hi + 1) * g.stride[axis];
+		i0 = size_t(lo) * g.stride[axis] - g.offset, i1 = size_t(hi + 1) * g.stride[axis] - g.offset;
 	}
 
 	// Symmetry planes normal to the slab axis fold the 2 node layers beyond them onto the 2 inside: that band

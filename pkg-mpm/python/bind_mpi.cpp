@@ -1,6 +1,8 @@
 // MPI build only (module yade_mpm._core_mpi, -DMPM_MPI): start-up of MPI and what Python may ask about
 // the decomposition (pkg-mpm/mpi/Decomposition.hpp, doc/developer/scaling.md).
 #include "binding_common.hpp"
+#include <cstdlib>
+#include <fstream>
 
 #ifdef MPM_MPI
 namespace mpm {
@@ -12,6 +14,23 @@ void finalize()
 	int done = 0;
 	MPI_Finalized(&done);
 	if (startedHere && !done) MPI_Finalize();
+}
+
+// Peak resident set size of this process [B] (VmHWM of /proc/self/status; 0 where unavailable).
+double peakRss()
+{
+	std::ifstream f("/proc/self/status");
+	std::string   line;
+	while (std::getline(f, line))
+		if (line.rfind("VmHWM:", 0) == 0) return 1024.0 * std::atof(line.c_str() + 6);
+	return 0;
+}
+template <int D>
+double particleBytes(Particles<D>& P)
+{
+	double b = double(P.id.capacity() * sizeof(int64_t) + P.mat.capacity());
+	P.forEachRealField([&](std::vector<Real>& f) { b += double(f.capacity() * sizeof(Real)); });
+	return b;
 }
 
 template <int D>
@@ -27,6 +46,17 @@ bp::dict mpiInfo(Solver<D>& s)
 	d["rebalances"]    = s.dd.rebalances; // re-cuts of the slabs (Solver.mpiRebalance)
 	d["imbalance"]     = s.dd.imbalance;  // max/mean of the per-rank particle counts at the last re-sort (after any re-cut)
 	d["haloBytesSent"] = s.dd.halo.bytesLastStep; // per shared-node exchange (two per step)
+	// memory of this rank (doc/developer/scaling.md): the node layers held along the last axis, the node and
+	// particle arrays' bytes (capacity), and the process's peak resident set so far (VmHWM)
+	bp::list held;
+	held.append(s.grid.layer0), held.append(s.grid.layerEnd);
+	d["heldLayers"]    = held;
+	d["gridNodes"]     = s.grid.size();
+	d["gridBytes"]     = s.grid.bytes();
+	d["particleBytes"] = particleBytes(s.P);
+	d["peakRSS"]       = peakRss();
+	d["distributedBuild"] = s.dd.building; // mpiDistribute: each rank built only its slab's particles
+	d["builtParticles"]   = s.dd.builtIds; // particles added over all ranks under distributed construction
 	return d;
 }
 
@@ -62,6 +92,13 @@ void mpiRestoreSlab(Solver<D>& s, bp::object first, long n)
 	s.requestSort();
 }
 
+// Distributed construction (Decomposition::distribute), before any particle is added.
+template <int D>
+void mpiDistribute(Solver<D>& s)
+{
+	s.dd.distribute(s.grid, s.P.n);
+}
+
 } // namespace
 
 // MPI_Init_thread at import (one thread per rank calls MPI: FUNNELED); MPI_Finalize when Python exits.
@@ -85,7 +122,9 @@ void initMpi()
 template <int D>
 void exposeMpi(SolverClass<D>& cls, const char*)
 {
-	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, rebalances, imbalance, haloBytesSent.");
+	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, rebalances, imbalance, haloBytesSent; memory: heldLayers, gridNodes, gridBytes, particleBytes, peakRSS [B].");
+	cls.def("_mpiDistribute", &mpiDistribute<D>,
+	        "Distributed construction (yade_mpm.parallel.distribute): from now on each rank keeps only the particles of its slab; before adding any.");
 	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, "Checkpoint resume: the saved slab layout and the rank's particle count (yade_mpm.checkpoint).");
 }
 template void exposeMpi<2>(SolverClass<2>&, const char*);

@@ -77,6 +77,7 @@ public:
 		const size_t old = P.n;
 		if (materials.size() && materials[size_t(material)].kind == MaterialKind::DruckerPragerGradyKipp)
 			materials[size_t(material)].dpgk.checkThresholds(vol, n, grid.spacing, D); // ε_D⁰ ∈ (0, 1) before anything is added
+		MPM_IF_MPI(if (dd.building) { if (!dd.appendOwn(grid, P, x, vol, mass, n, uint8_t(material))) return; } else) // only this rank's slab
 		P.append(x, vol, mass, n, grid.origin, grid.upper(), uint8_t(material));
 		if (materials.anyDpgk()) {
 			P.ensureDamageState(); // ε̄p is needed by the DP return even with damage off
@@ -203,7 +204,7 @@ public:
 	Real loadScale(Real t) const { return tractionRampTime > 0 ? std::min(1.0, t / tractionRampTime) : 1.0; }
 	Real maxSpeed() // max ‖v‖ [m/s], refreshed after requestSort(); MPI: a collective (every rank calls it)
 	{
-		if (needCheck && (P.n MPM_IF_MPI(|| dd.decomposed)) && materials.size()) prepare(); // a rank without particles joins
+		if (needCheck && (P.n MPM_IF_MPI(|| dd.decomposed || dd.building)) && materials.size()) prepare(); // a rank without particles joins
 		return vmax;
 	}
 	const BlockSchedule<D>& schedule() const { return sched; }
@@ -349,7 +350,7 @@ private:
 	// Validation that must precede any work; cheap when nothing changed.
 	void prepare()
 	{
-		if (P.n == 0 MPM_IF_MPI(&&!dd.decomposed)) throw InputError("particles: no particles in the solver; add particles before stepping");
+		if (P.n == 0 MPM_IF_MPI(&&!dd.decomposed && !dd.building)) throw InputError("particles: no particles in the solver; add particles before stepping");
 		if (materials.size() == 0) throw InputError("material: no material assigned; set a material before stepping");
 		if (!std::isfinite(dtDensityMin) || needCheck) {
 			// State edited through the live views (requestSort() after editing) is validated like

@@ -163,8 +163,33 @@ def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
         raise ValueError(f"keep must be a function of the (N, {len(lo)}) positions returning N booleans (got {type(keep).__name__})")
     d = spacing / ppc
     axes = [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)]
+    x = _lattice(axes, holes, keep)
+    if len(x) == 0:
+        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
+    return x, d ** len(lo)
+
+
+def fill_region_chunks(lo, hi, spacing, ppc=2, holes=(), keep=None, chunk=1 << 20):
+    """fill_region in pieces of about `chunk` lattice points (whole slices along x), yielding (positions,
+    volume) in fill_region's order, the same values; pieces without particles are left out."""
+    lo, hi = _corners(lo, hi, "region")
+    spacing = _number(spacing, "spacing", "m", positive=True)
+    ppc = _integer(ppc, "ppc (particles per cell per axis)", 1)
+    holes = _holes(holes, len(lo))
+    d = spacing / ppc
+    axes = [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)]
+    step = max(1, int(chunk) // max(1, int(np.prod([len(a) for a in axes[1:]]))))
+    for i0 in range(0, len(axes[0]), step):
+        x = _lattice([axes[0][i0:i0 + step]] + axes[1:], holes, keep)
+        if len(x):
+            yield x, d ** len(lo)
+
+
+def _lattice(axes, holes, keep):
+    """The lattice points of the axes (the last axis fastest) outside the holes and kept by `keep`."""
     grids = np.meshgrid(*axes, indexing="ij")
     x = np.column_stack([g.ravel() for g in grids])
+    del grids
     mask = np.ones(len(x), bool)
     for h in holes:
         mask &= ~h.contains(x)
@@ -173,10 +198,7 @@ def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
         if k.shape != (len(x),):
             raise ValueError(f"keep returned shape {k.shape}; expected ({len(x)},): one boolean per position")
         mask &= k.astype(bool)
-    x = x[mask]
-    if len(x) == 0:
-        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
-    return x, d ** len(lo)
+    return x[mask]
 
 
 def _holes(holes, dim):

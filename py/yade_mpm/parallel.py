@@ -8,8 +8,10 @@ instead when
 - ``YADE_MPM_MPI=1`` is set (``YADE_MPM_MPI=0`` forces the serial core), or
 - the process was started by Open MPI's ``mpirun`` with more than one rank (``OMPI_COMM_WORLD_SIZE`` > 1).
 
-Under ``srun`` (Slurm) set ``YADE_MPM_MPI=1``. Every rank runs the same script and builds the same scene;
-the first step keeps each rank's slab of particles (pkg-mpm/mpi/Decomposition.hpp).
+Under ``srun`` (Slurm) set ``YADE_MPM_MPI=1``. Every rank runs the same script. By default every rank builds
+the same scene and the first step keeps each rank's slab of particles (pkg-mpm/mpi/Decomposition.hpp);
+``distribute(solver)`` right after creating the solver makes each rank build only its slab (a scene larger
+than one process can hold; doc/guide/mpi.md).
 """
 import os
 
@@ -53,3 +55,15 @@ def size():
     """Number of MPI ranks (1 with the serial core)."""
     from . import _core
     return _core.mpiSize() if hasattr(_core, "mpiSize") else 1
+
+
+def distribute(solver):
+    """Distributed construction: call right after creating the solver, before adding particles. Each rank then
+    holds only the grid layers of its slab (block layers split evenly) and keeps of every add_region /
+    addParticles only the particles of its slab, with the ids 1 process would give; the first step re-cuts the
+    slabs by the particle counts. Nothing happens on 1 process. Builders that need every particle on every
+    rank refuse (add_region with thin gaps excluded, d0 = 'initial' bodies); a checkpoint resumes into the
+    replicated build only."""
+    if size() > 1:
+        solver._mpiDistribute()
+    return solver

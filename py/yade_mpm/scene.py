@@ -3,7 +3,7 @@ surface tractions (reading particle fields: ``yade_mpm.fields``)."""
 import numpy as np
 from . import _core
 from .fields import SYM_NAMES, dim_of
-from .geometry import _corners, _integer, _number, fill_region
+from .geometry import _corners, _integer, _number, fill_region, fill_region_chunks
 
 
 def make_solver(lo, hi, spacing, margin=2, shift=None):
@@ -88,6 +88,8 @@ def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="
         raise ValueError(f"region lo = {lo} must have {d} components for a {d}D solver")
     if gap_nodes not in GAP_NODES:
         raise ValueError(f"gap_nodes = {gap_nodes!r} must be one of {GAP_NODES}")
+    if _distributed(solver):
+        return _add_region_distributed(solver, material, lo, hi, ppc, holes, keep, gap_nodes)
     x, v = fill_region(lo, hi, solver.spacing, ppc, holes, keep)
     first = solver.numParticles
     index = material_index(solver, material)
@@ -97,6 +99,33 @@ def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="
         for i in thin_gap_nodes(solver, lo, hi, solver.spacing / ppc, holes):
             solver._setNodeExcluded(int(i), True)
     return np.arange(first, first + len(x))
+
+
+def _distributed(solver):
+    """True when each MPI rank builds only its slab of this solver's particles (yade_mpm.parallel.distribute)."""
+    return hasattr(solver, "mpiInfo") and bool(solver.mpiInfo()["distributedBuild"])
+
+
+def _add_region_distributed(solver, material, lo, hi, ppc, holes, keep, gap_nodes):
+    """add_region under distributed construction: the lattice in chunks of slices along x (at most about
+    CHUNK particles each, in the order of fill_region), each rank keeping its slab's particles (the core clips;
+    ids are the running index over all ranks, as on 1 process). Returns the global ids of the new particles."""
+    if gap_nodes == "excluded" and any(is_thin(h, solver.spacing) for h in (holes if not hasattr(holes, "contains") else [holes])):
+        raise ValueError("add_region: gap_nodes = 'excluded' with a thin hole needs every particle near the gap on every rank; under "
+                         "yade_mpm.parallel.distribute use gap_nodes = 'shared', or build the scene without distribute")
+    index = material_index(solver, material)
+    first = int(solver.mpiInfo()["builtParticles"])
+    total = 0
+    for x, v in fill_region_chunks(lo, hi, solver.spacing, ppc, holes, keep, CHUNK):   # fill_region's points and order
+        solver._addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
+        total += len(x)
+        del x
+    if total == 0:
+        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
+    return np.arange(first, first + total)
+
+
+CHUNK = 1 << 17   # particles generated at once by a distributed add_region (every rank generates every chunk)
 
 
 def thin_gap_nodes(solver, lo, hi, dp, holes):
@@ -184,9 +213,16 @@ def boundary_particles(solver, axis, side, tol=None):
     """Storage indices of the particle layer nearest the region face `side` (-1 low, +1 high) of `axis`."""
     _axis_side(solver, axis, side)
     d = solver.spacing / 2 if tol is None else _number(tol, "tol", "m", positive=True)
+    x = solver.view(f"x{axis}")
+    if _distributed(solver):   # each rank holds its slab: the face is the global edge (a collective)
+        from . import _core
+        m = _core.mpiMax([-x.min() if len(x) else -np.inf, x.max() if len(x) else -np.inf])
+        edge = -m[0] if side < 0 else m[1]
+        if not np.isfinite(edge):
+            raise ValueError("boundary_particles: the solver has no particles")
+        return np.nonzero(np.abs(x - edge) < 0.5 * d)[0]
     if solver.numParticles == 0:
         raise ValueError("boundary_particles: the solver has no particles")
-    x = solver.view(f"x{axis}")
     edge = x.min() if side < 0 else x.max()
     return np.nonzero(np.abs(x - edge) < 0.5 * d)[0]
 
@@ -199,10 +235,12 @@ def apply_traction(solver, indices, traction, area):
     idx = np.asarray(indices)
     if idx.ndim != 1 or not (idx.dtype.kind in "iu" or len(idx) == 0):
         raise ValueError(f"indices must be a 1-D array of integer particle slots (got dtype {idx.dtype}, shape {idx.shape})")
-    if len(idx) == 0:
+    if len(idx) == 0 and not _distributed(solver):   # distributed construction: a rank may hold none of the face
         raise ValueError("indices is empty: the traction would be applied to no particle")
     t = _traction(traction, d, len(idx))
     area = _number(area, "area", "m²", positive=True)
+    if len(idx) == 0:
+        return
     indices = idx
     try:
         old = np.column_stack([solver.view(f"trac{a}")[indices] for a in range(d)])
@@ -273,14 +311,19 @@ def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=Tr
     _integer(ppc, "ppc (particles per cell per axis)", 1)
     dp = solver.spacing / ppc                         # particle spacing = face length of a boundary particle
     beta = consistent_row_weights(ppc) if consistent else np.array([1.0])
-    if solver.numParticles == 0:
+    dist = _distributed(solver)
+    if solver.numParticles == 0 and not dist:
         raise ValueError("apply_face_traction: the solver has no particles")
     x = solver.view(f"x{axis}")
     depth = (x - face) if side < 0 else (face - x)
     row = np.round(depth / dp - 0.5).astype(int)      # 0 = outermost particle row
     rows = [np.nonzero(row == k)[0] for k in range(len(beta))]
+    counts = [len(r) for r in rows]
+    if dist:   # each rank holds its slab: a row has particles if it has on some rank (a collective)
+        from . import _core
+        counts = [int(c) for c in _core.mpiMax([float(c > 0) for c in counts])]
     for k, r in enumerate(rows):                       # a face off the lattice applied nothing before
-        if len(r) == 0:
+        if counts[k] == 0:
             raise ValueError(f"face x{axis} = {face} m (side {side:+d}) has no particles in row {k} of the {len(beta)} loaded rows: "
                              f"the particles span [{x.min():.6g}, {x.max():.6g}] m along axis {axis}; the face must be the "
                              f"{'lower' if side < 0 else 'upper'} edge of the particle lattice")

@@ -18,15 +18,18 @@ QUICK_STEPS = {"elastic2d_80k": 100, "elastic2d_1m": 15, "dpgk2d_80k": 100, "ela
 SPACING = 0.01  # grid spacing l [m]; 2 particles per cell per axis
 
 
-def build_scene(dim, material, cells):
+def build_scene(dim, material, cells, distribute=False):
     """The benchmark block: rock on a fixed floor with slip side walls, deformed by an initial
     pure-shear velocity field v = ε̇ (x − x_c) along x and −ε̇ (y − y_c) along y, so the stress grows
-    to the DP–GK yield and damage thresholds within the warm-up. Returns the solver."""
+    to the DP–GK yield and damage thresholds within the warm-up. Returns the solver. distribute: under
+    MPI each rank builds only its slab (yade_mpm.parallel.distribute)."""
     import yade_mpm as ym
     from yade_mpm import rocks
     size = [c * SPACING for c in cells]
     lo, hi = (0.0,) * dim, tuple(size)
     s = ym.make_solver(lo, hi, SPACING, margin=3)
+    if distribute:
+        ym.parallel.distribute(s)
     # the paper's granite (Sec. 3.1), elastic or with the DP–GK parameters of Sec. 3.2: at this strain
     # rate most particles yield and damage during the timed steps
     mat = rocks.granite() if material == "elastic" else rocks.granite_dpgk()

@@ -268,7 +268,10 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
         gone = int(header.get("removed", {}).get(n, 0))          # particles removed after leaving the grid
         # MPI: this rank's particles of the fresh scene; after removals: the particles still in the computation
         ids = arrays[f"solver/{n}/id"] if (mpi or gone) else None
-        if mpi and mpi[n]["total"] + gone != s.numParticles:
+        if mpi and s.mpiInfo().get("distributedBuild"):
+            problems.append(f"solver {n} was built with yade_mpm.parallel.distribute (each rank holds only its slab): a checkpoint "
+                            "resumes into the replicated build; build the scene without distribute to resume")
+        elif mpi and mpi[n]["total"] + gone != s.numParticles:
             problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
                             f"{s.numParticles} in this scene")
         if not mpi and gone and len(ids) + gone != s.numParticles:
