@@ -85,3 +85,19 @@ def test_convergence_paths_from_runs():
     assert peak["error"][-1] == pytest.approx(0.4 / 95.0)
     assert [p for p in paths if p["courant"] == 0.5][0]["spacing_m"] == []     # no runs at C = 0.5: an empty path
     assert "| uniaxial_intact |" in conv.table(dict(families={"uniaxial_intact": dict(paths=paths, failed=[])}))
+
+
+def test_tunnel_ensemble_reads_the_tunnel_scripts_files(tmp_path):
+    """The spread of a tunnel run reads what scripts/paper/tunnel_spalling.py writes: σ at 2 mm from the summary's
+    axial_stress_MPa_at rows, the first crack and the last snapshot's spalled areas from the case's case.json."""
+    import json
+    from yade_mpm_paper.report.uncertainty_sections import _tunnel_quantities
+    (tmp_path / "intact").mkdir()
+    snap = dict(spalled_by_place_mm2={"floor": 198.0}, left_waist_inward_mm=dict(p90=0.0157))
+    json.dump(dict(snapshots={"08ms": dict(snap, spalled_by_place_mm2={"floor": 1.0}), "20ms": snap},
+                   first_crack=dict(time=1.5826e-3, location="floor")), open(tmp_path / "intact" / "case.json", "w"))
+    summary = dict(cases=[dict(case="intact", axial_stress_MPa_at=[dict(displacement_mm=d, stress_MPa=100 * d) for d in (0.5, 1.0, 2.0)])])
+    q = _tunnel_quantities(str(tmp_path), summary)
+    assert q["σ at 2 mm [MPa], intact"] == 200.0
+    assert q["first crack [ms], intact"] == pytest.approx(1.5826)
+    assert q["spalled at the floor [mm²], intact"] == 198.0 and q["left waist moved in, p90 [mm], intact"] == 0.0157

@@ -70,13 +70,14 @@ def _tunnel_quantities(folder, summary):
     q = {}
     for e in summary.get("cases", []):
         c = e["case"]
-        q[f"σ at 2 mm [MPa], {c}"] = (e.get("stress_MPa_at_mm") or {}).get("2")
-        fc = e.get("first_crack") or {}
-        q[f"first crack [ms], {c}"] = fc.get("time_s") and fc["time_s"] * 1e3
+        at = {round(r["displacement_mm"], 6): r["stress_MPa"] for r in e.get("axial_stress_MPa_at") or []}   # tunnel_spalling.py's summary
+        q[f"σ at 2 mm [MPa], {c}"] = at.get(2.0)
         cj = os.path.join(folder, c, "case.json")
         if not os.path.exists(cj):
             continue
         info = json.load(open(cj))
+        fc = info.get("first_crack") or {}                      # case.json: time [s], location
+        q[f"first crack [ms], {c}"] = None if fc.get("time") is None else fc["time"] * 1e3
         snaps = info.get("snapshots") or {}
         last = snaps.get(max(snaps, key=lambda k: float(k.rstrip("ms")))) if snaps else None
         if not last:
