@@ -214,14 +214,19 @@ print(f"rank {rank} OK", flush=True)
 """
 
 
-def test_refusals_under_mpi(tmp_path):
-    """Unsupported or bad input under 2 ranks: a ValueError on every rank with a clear message, no hang."""
+def run_script_on_2_ranks(tmp_path, text):
+    """Run a script that prints "rank R OK" on each of 2 ranks (1 thread each); fail with its output otherwise."""
     script = tmp_path / "refusals.py"
-    script.write_text(REFUSALS)
+    script.write_text(text)
     env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
     r = subprocess.run([LAUNCH, "2", "1", str(script)], env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, (r.stdout[-3000:], r.stderr[-3000:])
     assert "rank 0 OK" in r.stdout and "rank 1 OK" in r.stdout, r.stdout
+
+
+def test_refusals_under_mpi(tmp_path):
+    """Unsupported or bad input under 2 ranks: a ValueError on every rank with a clear message, no hang."""
+    run_script_on_2_ranks(tmp_path, REFUSALS)
 
 
 EMPTY_RANK = r"""
