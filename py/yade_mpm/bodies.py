@@ -300,23 +300,28 @@ class RigidBodies:
     # ------------------------------------------------------------------ every step
     def read(self):
         """Kinematics, mass and inertia (``body_inertia``) of every registered body from O.bodies into the
-        solver (before the MPM step)."""
+        solver (before the MPM step). Runs every step: each body is looked up once and its state passed as
+        plain tuples (the per-step glue of a paper tunnel, doc/developer/performance.md)."""
         from yade import O
-        self._read_parts((bid, part) for bid, part, _ in self._parts)
+        s, d = self.solver, self.dim
         for bid, part, t in self._parts:
-            self.solver._setRigidPartMass(part, *body_inertia(O.bodies[bid], self.dim, t))
+            b = O.bodies[bid]
+            self._read_state(b.state, bid, part)
+            s._setRigidPartMass(part, *body_inertia(b, d, t))
 
     def _read_parts(self, pairs):
         from yade import O
-        d, s = self.dim, self.solver
         for bid, part in pairs:
-            st = O.bodies[bid].state
-            R, x, v, w = _rot(st.ori), st.pos, st.vel, st.angVel
-            if d == 2:
-                self._planar(R, bid)
-                s._setRigidPartState(part, (x[0], x[1]), R[:2, :2], (v[0], v[1]), w[2])
-            else:
-                s._setRigidPartState(part, (x[0], x[1], x[2]), R, (v[0], v[1], v[2]), (w[0], w[1], w[2]))
+            self._read_state(O.bodies[bid].state, bid, part)
+
+    def _read_state(self, st, bid, part):
+        m, x, v, w = st.ori.toRotationMatrix(), st.pos, st.vel, st.angVel
+        if self.dim == 2:
+            self._planar(m, bid)
+            self.solver._setRigidPartState(part, (x[0], x[1]), ((m[0, 0], m[0, 1]), (m[1, 0], m[1, 1])), (v[0], v[1]), w[2])
+        else:
+            R = tuple(tuple(m[i, j] for j in range(3)) for i in range(3))
+            self.solver._setRigidPartState(part, (x[0], x[1], x[2]), R, (v[0], v[1], v[2]), (w[0], w[1], w[2]))
 
     def write(self):
         """Contact reactions of the last MPM step into O.forces (2D: per-metre values × thickness)."""
