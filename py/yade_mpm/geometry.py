@@ -155,6 +155,26 @@ def rotated_rectangle(center, length, width, angle):
 def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
     """Particle centres and volume for the box [lo, hi] on a grid of spacing l with ppc particles per
     cell per axis, minus the holes. Returns (positions (N, D), volume per particle [m³])."""
+    axes, holes, v = _lattice_axes(lo, hi, spacing, ppc, holes, keep)
+    x = _lattice(axes, holes, keep)
+    if len(x) == 0:
+        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
+    return x, v
+
+
+def fill_region_chunks(lo, hi, spacing, ppc=2, holes=(), keep=None, chunk=1 << 20):
+    """fill_region in pieces of about `chunk` lattice points (whole slices along x), yielding (positions,
+    volume) in fill_region's order, the same values; pieces without particles are left out."""
+    axes, holes, v = _lattice_axes(lo, hi, spacing, ppc, holes, keep)
+    step = max(1, int(chunk) // max(1, int(np.prod([len(a) for a in axes[1:]]))))
+    for i0 in range(0, len(axes[0]), step):
+        x = _lattice([axes[0][i0:i0 + step]] + axes[1:], holes, keep)
+        if len(x):
+            yield x, v
+
+
+def _lattice_axes(lo, hi, spacing, ppc, holes, keep):
+    """The checked inputs of fill_region as (lattice coordinates per axis, holes as a list, volume per particle [m³])."""
     lo, hi = _corners(lo, hi, "region")
     spacing = _number(spacing, "spacing", "m", positive=True)
     ppc = _integer(ppc, "ppc (particles per cell per axis)", 1)
@@ -162,27 +182,7 @@ def fill_region(lo, hi, spacing, ppc=2, holes=(), keep=None):
     if keep is not None and not callable(keep):
         raise ValueError(f"keep must be a function of the (N, {len(lo)}) positions returning N booleans (got {type(keep).__name__})")
     d = spacing / ppc
-    axes = [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)]
-    x = _lattice(axes, holes, keep)
-    if len(x) == 0:
-        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
-    return x, d ** len(lo)
-
-
-def fill_region_chunks(lo, hi, spacing, ppc=2, holes=(), keep=None, chunk=1 << 20):
-    """fill_region in pieces of about `chunk` lattice points (whole slices along x), yielding (positions,
-    volume) in fill_region's order, the same values; pieces without particles are left out."""
-    lo, hi = _corners(lo, hi, "region")
-    spacing = _number(spacing, "spacing", "m", positive=True)
-    ppc = _integer(ppc, "ppc (particles per cell per axis)", 1)
-    holes = _holes(holes, len(lo))
-    d = spacing / ppc
-    axes = [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)]
-    step = max(1, int(chunk) // max(1, int(np.prod([len(a) for a in axes[1:]]))))
-    for i0 in range(0, len(axes[0]), step):
-        x = _lattice([axes[0][i0:i0 + step]] + axes[1:], holes, keep)
-        if len(x):
-            yield x, d ** len(lo)
+    return [np.arange(a + d / 2, b - d / 4, d) for a, b in zip(lo, hi)], holes, d ** len(lo)
 
 
 def _lattice(axes, holes, keep):

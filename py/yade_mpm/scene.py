@@ -3,7 +3,7 @@ surface tractions (reading particle fields: ``yade_mpm.fields``)."""
 import numpy as np
 from . import _core
 from .fields import SYM_NAMES, dim_of
-from .geometry import _corners, _integer, _number, fill_region, fill_region_chunks
+from .geometry import _corners, _holes, _integer, _number, fill_region, fill_region_chunks
 
 
 def make_solver(lo, hi, spacing, margin=2, shift=None):
@@ -110,7 +110,7 @@ def _add_region_distributed(solver, material, lo, hi, ppc, holes, keep, gap_node
     """add_region under distributed construction: the lattice in chunks of slices along x (at most about
     CHUNK particles each, in the order of fill_region), each rank keeping its slab's particles (the core clips;
     ids are the running index over all ranks, as on 1 process). Returns the global ids of the new particles."""
-    if gap_nodes == "excluded" and any(is_thin(h, solver.spacing) for h in (holes if not hasattr(holes, "contains") else [holes])):
+    if gap_nodes == "excluded" and any(is_thin(h, solver.spacing) for h in _holes(holes, dim_of(solver))):
         raise ValueError("add_region: gap_nodes = 'excluded' with a thin hole needs every particle near the gap on every rank; under "
                          "yade_mpm.parallel.distribute use gap_nodes = 'shared', or build the scene without distribute")
     index = material_index(solver, material)
