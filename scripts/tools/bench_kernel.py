@@ -15,6 +15,7 @@ code of the kernel's shape (its positions in float are unusable for the paper's 
     /usr/bin/python3 scripts/tools/bench_kernel.py now=py                                 # this build, 3 rounds
     /usr/bin/python3 scripts/tools/bench_kernel.py before=/tmp/wt-before/py now=py --rounds 5 --case dpgk2d_80k
     /usr/bin/python3 scripts/tools/bench_kernel.py now=py --float-kernel                  # + the all-float kernel
+    /usr/bin/python3 scripts/tools/bench_kernel.py now=py damped=py@damping=0.05         # one build, two settings
 """
 import argparse
 import json
@@ -77,10 +78,14 @@ def run_kernel(exe, mat, threads=1, env=None):
     return n / float(re.search(r"wall=([\d.]+)s", r).group(1)), n / float(re.search(r"CPU ([\d.]+)", r).group(1)), re.search(r"phases: (.*)\|", r).group(1)
 
 
-def run_build(py, case):
+def run_build(spec, case):
+    """spec: PATH of a build's py/, optionally PATH@key=value,key=value: solver settings for the timed scene."""
+    py, _, sets = spec.partition("@")
+    settings = {k: json.loads(v) for k, v in (kv.split("=", 1) for kv in sets.split(",") if kv)}
     bench = os.path.join(os.path.dirname(os.path.abspath(py)), "scripts", "tools", "bench.py")
     r = subprocess.run([sys.executable, bench, "--child", "--mode", "direct", "--case", case, "--steps", str(STEPS), "--warmup", str(WARMUP)],
-                       env=dict(ENV1, PYTHONPATH=os.path.abspath(py)), capture_output=True, text=True)
+                       env=dict(ENV1, PYTHONPATH=os.path.abspath(py), YADE_MPM_BENCH_SETTINGS=json.dumps(settings)), capture_output=True,
+                       text=True)
     line = [x for x in r.stdout.splitlines() if x.startswith("BENCH ")]
     if not line:
         raise SystemExit(f"{py}: benchmark child failed\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
@@ -91,7 +96,8 @@ def run_build(py, case):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("builds", nargs="+", help="NAME=PATH of a build's py/ directory")
+    ap.add_argument("builds", nargs="+", help="NAME=PATH of a build's py/ directory; NAME=PATH@key=value,… also sets solver "
+                    "settings of the timed scene (e.g. damped=py@damping=0.05)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--case", default="elastic2d_80k", choices=["elastic2d_80k", "dpgk2d_80k"])
     ap.add_argument("--kernel-source", default=SOURCE)

@@ -3,6 +3,7 @@
 cases (CASES, build_scene), the paper-scale scenes (PAPER), the YADE hook, the spheres case (SPHERES) and the
 contact case (CONTACT_CASE). Nothing is printed or written while the timed steps run."""
 import json
+import os
 import time
 
 
@@ -13,6 +14,7 @@ CASES = {
     "dpgk2d_80k": (2, "dpgk", (200, 100), 300, 20),
     "elastic3d_500k": (3, "elastic", (50, 50, 25), 30, 3),
 }
+SETTINGS_ENV = "YADE_MPM_BENCH_SETTINGS"  # JSON dict of solver settings for the timed scene (benchmarks only)
 QUICK_STEPS = {"elastic2d_80k": 100, "elastic2d_1m": 15, "dpgk2d_80k": 100, "elastic3d_500k": 10}
 
 SPACING = 0.01  # grid spacing l [m]; 2 particles per cell per axis
@@ -88,6 +90,7 @@ def timed(build, steps, warmup, advance=None):
     import yade_mpm as ym
     rss0 = peak_rss_bytes()
     s = build()
+    s.setSettings(json.loads(os.environ.get(SETTINGS_ENV, "{}")))   # an A/B of one build's settings (bench_kernel NAME=PATH@k=v)
     advance = advance or s.run   # (a YADE scene passes its own: O.step)
     advance(warmup)
     s._resetPhaseTimes()
