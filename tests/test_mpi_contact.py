@@ -1,6 +1,7 @@
 """Rigid YADE bodies under MPI (pkg-mpm/mpi/MpiExchange.hpp, doc/developer/scaling.md "Rigid bodies"): every rank runs the
 same YADE scene; the contact of each rank's nodes is reduced over the ranks in rank order before YADE
-integrates the bodies. A 2D elastic block falling at 5 m/s (particles cross the slab boundary) is pushed by a rigid top platen (only the upper rank touches it) and a right platen (both ranks),
+integrates the bodies (penalty law), or every rank solves every rank's contacts of a body in one order (kinematic law,
+the default). A 2D elastic block falling at 5 m/s (particles cross the slab boundary) is pushed by a rigid top platen (only the upper rank touches it) and a right platen (both ranks),
 and holds a free rigid filler in a vertical slot across the slab boundary (its stick step, bodyResponse,
 sums nodes of both ranks). On 2 ranks against 1 process (serial core), 150 steps: the particle fields by id,
 the three bodies' impulses (Σ reaction · Δt) and the filler's motion agree within 1e-10 relative (roundoff: the sums are
@@ -59,14 +60,31 @@ np.savez(f"{out}.{info['rank']}.npz", **res)
 NAMES = ["x0", "x1", "v0", "v1", "sig0", "sig1", "sig2", "sig3", "vol"]
 
 
-def _run(tmp_path, tag, steps, ranks):
-    parts = run_child(tmp_path, CHILD, "contact_child.py", tag, steps, ranks, timeout=900)   # a hang fails here
+
+
+def _child(law, damping):
+    """The scene with every body under `law` (the default kinematic law: every rank gathers every rank's contacts of
+    a body and solves them all in (block, id) order) and Cundall damping (with bodies: the kinematic law's
+    re-projection after the damping, whose node velocities are gathered again)."""
+    c = CHILD.replace('law="penalty"', f'law="{law}"')
+    return c.replace("eng = yade_engines", f"s.damping = {damping}\neng = yade_engines") if damping else c
+
+
+def _run(tmp_path, tag, steps, ranks, child=CHILD):
+    parts = run_child(tmp_path, child, "contact_child.py", tag, steps, ranks, timeout=900)   # a hang fails here
     return parts
 
 
-def test_bodies_two_ranks_match_one(tmp_path):
-    ref = _run(tmp_path, "one", 150, 1)
-    parts = _run(tmp_path, "two", 150, 2)
+# Agreement with 1 process: round-off of the sums added in another order, amplified by the scene. The kinematic law
+# (a constraint switched on at a touching threshold) amplifies it more than the penalty law; Cundall damping
+# (f − α|f| sign v, discontinuous where a nodal velocity crosses 0) far more, for both laws (penalty with damping 0.05:
+# 6e-6 on this scene), so with damping the bar only says the ranks follow 1 process.
+@pytest.mark.parametrize("law,damping,bar", [("penalty", 0, 1e-10), ("kinematic", 0, 1e-9), ("kinematic", 0.05, 1e-4)])
+def test_bodies_two_ranks_match_one(tmp_path, law, damping, bar):
+    child = _child(law, damping)
+    assert child.count(f'law="{law}"') == 3
+    ref = _run(tmp_path, "one", 150, 1, child)
+    parts = _run(tmp_path, "two", 150, 2, child)
     one, two = _merge(ref, NAMES), _merge(parts, NAMES)
     first = parts[0]["first"]
     assert list(first) == [0, 2, 5], first   # 36 cells (2 of margin each side): split at 16 cells from y = −0.02, y = 0.14 m
@@ -84,41 +102,6 @@ def test_bodies_two_ranks_match_one(tmp_path):
     rel = _max_rel(one, two)
     print(f"bodies under MPI: fields {rel:.2e}, impulses {rel_f}, filler velocity {rel_fill:.2e}, "
           f"filler position {np.abs(fill2[:2] - fill1[:2]).max():.2e} m")
-    assert rel <= 1e-10 and rel_f.max() <= 1e-10 and rel_fill <= 1e-10
-    assert np.abs(fill2[:3] - fill1[:3]).max() <= 1e-13
+    assert rel <= bar and rel_f.max() <= bar and rel_fill <= bar
+    assert np.abs(fill2[:3] - fill1[:3]).max() <= 1e-3 * bar
     assert float(parts[0]["time"][0]) == pytest.approx(float(ref[0]["time"][0]), rel=1e-12)
-
-
-REFUSE = r"""
-import sys
-import numpy as np
-import yade_mpm as ym
-import yade_mpm.parallel
-from yade import O, utils
-from yade_mpm.bodies import RigidBodies
-steps, out = int(sys.argv[1]), sys.argv[2]
-s = ym.make_solver((0.0, 0.0), (0.2, 0.32), 0.01, margin=2)
-ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0.0), (0.2, 0.2))
-O.reset()
-rb = RigidBodies(s)
-box = O.bodies.append(utils.box((0.1, 0.25, 0), (0.1, 0.02, 0.5), fixed=True))
-try:
-    rb.add(box, mu=0.3)                         # the default law: kinematic
-    msg = "accepted"
-except ValueError as e:
-    msg = str(e)
-box2 = O.bodies.append(utils.box((0.1, 0.29, 0), (0.1, 0.01, 0.5), fixed=True))
-rb.add(box2, mu=0.3, law="penalty")             # the named option runs
-np.savez(f"{out}.{ym.parallel.rank()}.npz", msg=msg, active=s._contactActive, groups=s._numContactGroups)
-"""
-
-
-def test_kinematic_law_is_refused_at_registration_on_several_ranks(tmp_path):
-    """Several MPI ranks do not run the kinematic law yet: registering a body with it is refused before anything is
-    added, naming the parameter and the option that runs (law='penalty'); one process accepts it."""
-    parts = run_child(tmp_path, REFUSE, "refuse.py", "mpi", 1, 2, 300)
-    for p in parts:
-        assert "law" in str(p["msg"]) and "penalty" in str(p["msg"]) and "kinematic" in str(p["msg"])
-        assert int(p["groups"]) == 1 and bool(p["active"])
-    one = run_child(tmp_path, REFUSE, "refuse.py", "one", 1, 1, 300)
-    assert str(one[0]["msg"]) == "accepted" and int(one[0]["groups"]) == 2

@@ -2,8 +2,13 @@
 // Eq. 23, reached at any Δt by constraining the velocities of the touching particles (no approach, Coulomb + cohesion
 // as an impulse limit, Eq. 24) with impulses found by projected Gauss–Seidel over the contacts in a fixed order (one
 // thread). A layer of PtsContact (Base: ContactDetection); the derivation: doc/developer/core_notes.md.
+// Under MPI every process gathers every process's contacts of a group (with the velocities of their nodes) and
+// solves them all in the same order (block, then particle id): the same impulses on every process and in one
+// process; each process then writes the velocities of the nodes it holds and reports its own contacts' reactions.
 #pragma once
 #include "ContactDetection.hpp"
+#include <algorithm>
+#include <array>
 
 namespace mpm {
 
@@ -23,17 +28,37 @@ template <int D>
 struct KinematicContactRec {
 	using Vec = typename Dim<D>::Vec;
 	static constexpr int N = Dim<D>::nStencil;
-	size_t node[N];  // distinct nodes of the modelled region (count nn)
-	Real   rd[N][D]; // per-axis weight of node[k] in the particle's velocity, v_p[a] = Σ_k rd[k][a] v[node k][a]
-	Real   w[N][D];  // per-axis weight of node[k] in the particle's impulse, Δv[node k][a] = w[k][a] λ[a]/m_k
-	Real   invM[N];  // 1/m of node[k] [1/kg]
-	int    nn;
-	int    part;
-	Vec    x, n, r;  // particle position, contact normal, lever arm x_p − c
-	Real   g;        // target normal rate (d0 − d_p)/Δt [m/s]
-	Real   cap0;     // cohesive part of the tangential capacity c a_p Δt [N s]
-	Vec    kinvAxis; // Σ_k rd[k][a] w[k][a]/m_k over the nodes whose component a is free [1/kg]
-	Vec    lam;      // impulse on the particle [N s]
+	size_t   node[N];   // distinct nodes of the modelled region, global indices (count nn)
+	int      slot[N];   // their entries in the group's node table
+	Real     rd[N][D];  // per-axis weight of node[k] in the particle's velocity, v_p[a] = Σ_k rd[k][a] v[node k][a]
+	Real     w[N][D];   // per-axis weight of node[k] in the particle's impulse, Δv[node k][a] = w[k][a] λ[a]/m_k
+	Real     invM[N];   // 1/m of node[k] [1/kg]
+	Real     vel[N][D]; // velocity of node[k] after the grid update [m/s] (the node table's input)
+	uint8_t  fix[N];    // fixMask of node[k]
+	int      nn;
+	int      part;
+	uint32_t block;     // the particle's block; contacts are solved in (block, id) order
+	int64_t  id;        // the particle's id
+	bool     mine;      // found by this process: its reaction is this process's share
+	Vec      x, n, r;   // particle position, contact normal, lever arm x_p − c
+	Real     g;         // target normal rate (d0 − d_p)/Δt [m/s]
+	Real     cap0;      // cohesive part of the tangential capacity c a_p Δt [N s]
+	Vec      kinvAxis;  // Σ_k rd[k][a] w[k][a]/m_k over the nodes whose component a is free [1/kg]
+	Vec      lam;       // impulse on the particle [N s]
+};
+
+// The distinct nodes of a group's contacts (global indices, ascending) with the velocities the solver updates.
+template <int D>
+struct KinematicNodeTable {
+	std::vector<size_t>            node;  // global index
+	std::vector<std::array<Real, D>> v;   // velocity [m/s]
+	std::vector<uint8_t>           fix;   // fixMask
+	std::vector<size_t>            local; // index in this process's node arrays, SIZE_MAX when it does not hold the node
+	struct Update {                        // a node's velocity sent by the process that owns it (refresh)
+		size_t slot;
+		Real   v[D];
+	};
+	std::vector<Update> upd;
 };
 
 template <int D, class Base>
@@ -54,20 +79,27 @@ public:
 	void applyKinematic(size_t gi, const ContactStep<D, X>& s)
 	{
 		collect(gi, s);
-		solve(s.grid, gi);
+		share(gi, s);
+		solve(gi);
+		store(s.grid, gi);
 		reactions(gi, s.dt, 1);
 	}
 	// After the late damping (dampAfterContact), one thread: the damped velocities meet the constraints again; the
 	// reactions are those of the total impulse.
-	void reprojectKinematic(Grid<D>& grid, size_t gi, Real dt)
+	template <class X>
+	void reprojectKinematic(size_t gi, const ContactStep<D, X>& s)
 	{
-		reactions(gi, dt, -1);
-		solve(grid, gi);
-		reactions(gi, dt, 1);
+		if (gi >= kcs.size()) return;
+		refresh(gi, s);
+		reactions(gi, s.dt, -1);
+		solve(gi);
+		store(s.grid, gi);
+		reactions(gi, s.dt, 1);
 	}
 
 private:
-	std::vector<std::vector<KinematicContactRec<D>>> kcs; // per group: its contacts this step (capacity kept between steps)
+	std::vector<std::vector<KinematicContactRec<D>>> kcs;  // per group: its contacts this step (capacity kept between steps)
+	std::vector<KinematicNodeTable<D>>               tabs; // per group: the nodes of its contacts
 
 	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
 	static Vec bodyCompliance(const RigidPart<D>& q, const Vec& r, const Vec& e)
@@ -83,7 +115,7 @@ private:
 		return k + e.dot(bodyCompliance(q, c.r, e));
 	}
 
-	// 1. the contacting particles of the blocks near group gi's body, in block order
+	// 1. this process's contacting particles of the blocks near group gi's body, in block order
 	template <class X>
 	void collect(size_t gi, const ContactStep<D, X>& s)
 	{
@@ -92,10 +124,6 @@ private:
 		const BlockSchedule<D>&  sched = s.sched;
 		const StencilOffsets<D>& offs  = s.offs;
 		const GroupWork<D>&      wk    = work[gi];
-		if (s.exchange.distributed()) {
-			s.err.record(0, "is in a scene with a kinematic contact group, which a distributed run does not support yet (use law='penalty')");
-			return;
-		}
 		if (kcs.size() < groups.size()) kcs.resize(groups.size());
 		const auto& g  = groups[gi];
 		auto&       kc = kcs[gi];
@@ -132,8 +160,8 @@ private:
 					while (k < c.nn && c.node[k] != i) ++k; // a node reached twice (directly and as an image): one entry
 					if (k == c.nn) {
 						if (c.nn == N) return -1; // cannot happen: at most 4^D distinct nodes of the modelled region
-						c.node[k] = i, c.invM[k] = 1 / grid.nodes[i].m, ++c.nn;
-						for (int a = 0; a < D; ++a) c.rd[k][a] = c.w[k][a] = 0;
+						c.node[k] = i, c.invM[k] = 1 / grid.nodes[i].m, c.fix[k] = grid.fixMask[i], ++c.nn;
+						for (int a = 0; a < D; ++a) c.rd[k][a] = c.w[k][a] = 0, c.vel[k][a] = grid.vel[i].c[a];
 					}
 					return k;
 				};
@@ -162,9 +190,12 @@ private:
 				c.x = x, c.n = h.n, c.r = x - parts[c.part].c;
 				// Σ rd·w/m over the free components of the nodes, per axis (a boundary plane holds a component)
 				for (int a = 0; a < D; ++a) c.kinvAxis[a] = 0;
-				for (int k = 0; k < c.nn; ++k)
+				for (int k = 0; k < c.nn; ++k) {
 					for (int a = 0; a < D; ++a)
-						if (!((grid.fixMask[c.node[k]] >> a) & 1)) c.kinvAxis[a] += c.rd[k][a] * c.w[k][a] * c.invM[k];
+						if (!((c.fix[k] >> a) & 1)) c.kinvAxis[a] += c.rd[k][a] * c.w[k][a] * c.invM[k];
+					c.node[k] += grid.offset; // global index from here on
+				}
+				c.block = uint32_t(bl), c.id = P.id[p], c.mine = true;
 				c.g    = (d0 - h.d) / s.dt;
 				c.cap0 = g.params.cohesion * (P.vol[p] / e) * s.dt;
 				c.lam.setZero();
@@ -180,17 +211,73 @@ private:
 			}
 			if (a == D) break;
 		}
-		for (const auto& c : kc) // nodes of the records outside the box (partners of images)
-			for (int k = 0; k < c.nn; ++k)
-				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] = 0;
 		for (int p : g.parts) dq[p] = BodyMotion<D> {};
 	}
 
-	// 2. projected Gauss–Seidel on the impulses of group gi (free parts' velocity changes in dq); continues from
-	// the impulses found so far, so a second call after the late damping restores the constraints.
-	void solve(Grid<D>& grid, size_t gi)
+	// 2. every process's contacts of group gi in (block, id) order, and the table of their nodes
+	template <class X>
+	void share(size_t gi, const ContactStep<D, X>& s)
+	{
+		auto&        kc   = kcs[gi];
+		const size_t mine = kc.size(), at = s.exchange.gatherInOrder(kc);
+		for (size_t j = 0; j < kc.size(); ++j) kc[j].mine = j >= at && j < at + mine;
+		s.exchange.agree(s.err, "contact");
+		std::sort(kc.begin(), kc.end(), [](const KinematicContactRec<D>& a, const KinematicContactRec<D>& b) {
+			return a.block != b.block ? a.block < b.block : a.id < b.id;
+		});
+		if (tabs.size() < groups.size()) tabs.resize(groups.size());
+		auto& t = tabs[gi];
+		t.node.clear();
+		for (const auto& c : kc) t.node.insert(t.node.end(), c.node, c.node + c.nn);
+		std::sort(t.node.begin(), t.node.end());
+		t.node.erase(std::unique(t.node.begin(), t.node.end()), t.node.end());
+		t.v.resize(t.node.size()), t.fix.resize(t.node.size()), t.local.resize(t.node.size());
+		const Grid<D>& grid = s.grid;
+		for (auto& c : kc)
+			for (int k = 0; k < c.nn; ++k) {
+				const size_t j = size_t(std::lower_bound(t.node.begin(), t.node.end(), c.node[k]) - t.node.begin());
+				c.slot[k] = int(j), t.fix[j] = c.fix[k];
+				for (int a = 0; a < D; ++a) t.v[j][a] = c.vel[k][a];
+			}
+		for (size_t j = 0; j < t.node.size(); ++j) {
+			const size_t gn = t.node[j];
+			t.local[j]      = gn >= grid.offset && gn - grid.offset < grid.size() ? gn - grid.offset : SIZE_MAX;
+			if (t.local[j] != SIZE_MAX)
+				for (int a = 0; a < D; ++a) nodeArr.force[a][t.local[j]] = 0; // nodes of the records outside the box
+		}
+	}
+
+	// The table's velocities from the grid again (after the late damping): each process sends those of the nodes it owns.
+	template <class X>
+	void refresh(size_t gi, const ContactStep<D, X>& s)
+	{
+		auto& t = tabs[gi];
+		t.upd.clear();
+		for (size_t j = 0; j < t.node.size(); ++j)
+			if (t.local[j] != SIZE_MAX && s.exchange.owns(t.local[j])) {
+				typename KinematicNodeTable<D>::Update u { j, {} };
+				for (int a = 0; a < D; ++a) u.v[a] = s.grid.vel[t.local[j]].c[a];
+				t.upd.push_back(u);
+			}
+		s.exchange.gatherInOrder(t.upd);
+		for (const auto& u : t.upd)
+			for (int a = 0; a < D; ++a) t.v[u.slot][a] = u.v[a];
+	}
+	// The table's velocities into the nodes this process holds.
+	void store(Grid<D>& grid, size_t gi) const
+	{
+		const auto& t = tabs[gi];
+		for (size_t j = 0; j < t.node.size(); ++j)
+			if (t.local[j] != SIZE_MAX)
+				for (int a = 0; a < D; ++a) grid.vel[t.local[j]].c[a] = t.v[j][a];
+	}
+
+	// 3. projected Gauss–Seidel on the impulses of group gi over its node table (free parts' velocity changes in dq);
+	// continues from the impulses found so far, so a second call after the late damping restores the constraints.
+	void solve(size_t gi)
 	{
 		if (gi >= kcs.size()) return;
+		auto& t = tabs[gi];
 		const auto& g     = groups[gi];
 		auto&       kc    = kcs[gi];
 		const Real  mu    = g.params.mu;
@@ -201,7 +288,7 @@ private:
 				const auto& q  = parts[c.part];
 				Vec         vp = Vec::Zero();
 				for (int k = 0; k < c.nn; ++k)
-					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * grid.vel[c.node[k]].c[a];
+					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * t.v[size_t(c.slot[k])][a];
 				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r); // u_p = v_p − (v + ω × r_p), Eqs. 6, 26
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal
@@ -226,10 +313,10 @@ private:
 				if (dl.isZero(0)) continue;
 				c.lam = lam;
 				for (int k = 0; k < c.nn; ++k) {
-					const size_t  i   = c.node[k];
-					const uint8_t fix = grid.fixMask[i];
+					const size_t  j   = size_t(c.slot[k]);
+					const uint8_t fix = t.fix[j];
 					for (int a = 0; a < D; ++a)
-						if (!((fix >> a) & 1)) grid.vel[i].c[a] += c.w[k][a] * c.invM[k] * dl[a];
+						if (!((fix >> a) & 1)) t.v[j][a] += c.w[k][a] * c.invM[k] * dl[a];
 				}
 				if (q.movable()) { // the free body takes −Δλ at x_p
 					dq[c.part].v -= dl / q.mass;
@@ -241,17 +328,23 @@ private:
 		}
 	}
 
-	// 3. reactions sign·(−λ/Δt) at x_p and the nodal contact forces sign·Σ_k w_k ∘ λ/Δt, in contact order
-	// (sign −1 takes back what an earlier call reported, before the re-projection after the late damping).
+	// 4. reactions sign·(−λ/Δt) at x_p of this process's contacts and the nodal contact forces sign·Σ_k w_k ∘ λ/Δt of
+	// the nodes it holds, in contact order (sign −1 takes back what an earlier call reported, before the
+	// re-projection after the late damping).
 	void reactions(size_t gi, Real dt, int sign)
 	{
 		if (gi >= kcs.size()) return;
-		auto& A = nodeArr;
+		auto&       A = nodeArr;
+		const auto& t = tabs[gi];
 		for (const auto& c : kcs[gi]) {
 			// the body takes −λ/Δt at x_p (its images' share is theirs); the nodal forces Σ_k w_k ∘ λ/Δt
 			const Vec f = (sign / dt) * c.lam;
-			for (int k = 0; k < c.nn; ++k)
-				for (int a = 0; a < D; ++a) A.force[a][c.node[k]] += c.w[k][a] * f[a];
+			for (int k = 0; k < c.nn; ++k) {
+				const size_t i = t.local[size_t(c.slot[k])];
+				if (i != SIZE_MAX)
+					for (int a = 0; a < D; ++a) A.force[a][i] += c.w[k][a] * f[a];
+			}
+			if (!c.mine) continue;
 			auto& q = parts[c.part];
 			q.force -= f;
 			q.torque -= momentOf<D>(c.r, f);

@@ -38,13 +38,19 @@ public:
 	{
 		if (!hasKinematic()) return;
 		s.exchange.oneThread([&] {
+			const bool dist = s.exchange.distributed(); // the reactions' changes are summed over the processes like apply's
+			if (dist) kept.assign(parts.begin(), parts.end());
+			if (dist) for (auto& q : parts) q.force.setZero(), q.torque.setZero();
 			for (size_t gi = 0; gi < groups.size(); ++gi)
-				if (groups[gi].params.law == ContactLaw::Kinematic && !work[gi].skip) this->reprojectKinematic(s.grid, gi, s.dt);
+				if (groups[gi].params.law == ContactLaw::Kinematic && !work[gi].skip) this->reprojectKinematic(gi, s);
+			if (dist) sumReactions(s.exchange);
+			if (dist) for (size_t p = 0; p < parts.size(); ++p) parts[p].force += kept[p].force, parts[p].torque += kept[p].torque;
 		});
 	}
 
 private:
-	std::vector<double> partSums; // scratch of sumReactions
+	std::vector<double>        partSums; // scratch of sumReactions
+	std::vector<RigidPart<D>>  kept;     // scratch of reproject: the reactions before it
 
 	// Some kinematic group has work this step (set by beforeTransfer).
 	bool hasKinematic() const

@@ -21,6 +21,12 @@ struct LocalExchange {
 	void sumSharedArrays(const G&, Real* const*, int, ErrorRecord&, const char*) const { }
 	// In oneThread: v ← the sum of every process's v in a fixed order (the same bits on each).
 	void sumInOrder(double*, int) const { }
+	// In oneThread: v ← every process's v concatenated in process order (T trivially copyable); returns where this
+	// process's entries start.
+	template <class T>
+	size_t gatherInOrder(std::vector<T>&) const { return 0; }
+	// In oneThread: a failure recorded on any process reaches every err (the others' as "elsewhere").
+	void agree(ErrorRecord&, const char*) const { }
 	// Every thread: f() on the one thread that may communicate, then a barrier.
 	template <class F>
 	static void oneThread(F&& f)

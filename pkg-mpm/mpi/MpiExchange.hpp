@@ -4,6 +4,7 @@
 #pragma once
 #include "../core/Exchange.hpp"
 #include "Decomposition.hpp"
+#include <cstring>
 
 #ifdef MPM_MPI
 namespace mpm {
@@ -27,6 +28,21 @@ struct MpiExchange {
 		dd->halo.sumSpans(dd->layout, grid, dd->rank, sp, n, err, phase);
 	}
 	void sumInOrder(double* v, int n) const { dd->sumInRankOrder(v, n); }
+	template <class T>
+	size_t gatherInOrder(std::vector<T>& v) const
+	{
+		if (!distributed()) return 0;
+		std::vector<char> all;
+		const size_t      at = Comm::gatherBytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T), all);
+		v.resize(all.size() / sizeof(T));
+		std::memcpy(static_cast<void*>(v.data()), all.data(), all.size());
+		return at / sizeof(T);
+	}
+	void agree(ErrorRecord& err, const char* phase) const
+	{
+		if (distributed() && !Comm::all(err.none()) && err.none())
+			err.record(ErrorRecord::elsewhere, std::string("stopped: the ") + phase + " of another MPI rank failed (its message names the particle)");
+	}
 	// MPI is called by the master thread only (MPI_THREAD_FUNNELED), hence master and a barrier, not `single`.
 	template <class F>
 	static void oneThread(F&& f)

@@ -54,9 +54,6 @@ struct ContactWrap {
 		}
 		std::vector<int> ps;
 		for (long k = 0; k < bp::len(parts); ++k) ps.push_back(int(argInt(parts[k], who("addContactGroup: parts"), 0, 2147483647.0)));
-		MPM_IF_MPI(if (s.dd.distributed() && prm.law == ContactLaw::Kinematic) throw InputError(
-		                   who("addContactGroup: params.law") + " = 'kinematic' is not run on several MPI ranks yet (this run has " +
-		                   std::to_string(s.dd.R) + "): register the body with law='penalty'");)
 		return s.contact.addGroup(prm, ps);
 	}
 	static ContactParams contactParams(S& s, int g) { return s.contact.group(g).params; }
