@@ -259,11 +259,17 @@ struct Grid {
 	}
 
 private:
+	// Node arrays of exactly s zeroed nodes. The old arrays are freed first: assign would keep their capacity, so
+	// a window narrowed from the whole grid (MPI, setWindow) would still hold the whole grid's pages.
 	void allocate(size_t s)
 	{
-		nodes.assign(s, Node<D> {});
-		vel.assign(s, NodeVec<D> {}), vold.assign(s, NodeVec<D> {}), mom.assign(s, NodeVec<D> {}), vmusl.assign(s, NodeVec<D> {});
-		fixMask.assign(s, 0);
+		fresh(nodes, s), fresh(vel, s), fresh(vold, s), fresh(mom, s), fresh(vmusl, s), fresh(fixMask, s);
+	}
+	template <class V>
+	static void fresh(V& v, size_t s)
+	{
+		V().swap(v);
+		v.resize(s); // value-initialised: zero
 	}
 	static std::string num(Real v)
 	{
