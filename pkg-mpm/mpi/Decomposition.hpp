@@ -6,6 +6,7 @@
 #include "HaloExchange.hpp"
 #include "ParticlePack.hpp"
 #include <malloc.h>
+#include <unistd.h>
 
 #ifdef MPM_MPI
 namespace mpm {
@@ -26,9 +27,10 @@ public:
 
 	bool distributed() const { return R > 1; }
 	// Distributed construction, before any particle exists: the slabs start evenly (block layers split by
-	// count, SlabLayout::even), the grid keeps this rank's window of them, and every later addParticles keeps
-	// only the particles of this rank's slab (clip), with the global running index as id (the ids of 1 process).
-	// The first step re-cuts by the particle counts (the start rule) and moves particles to their owners.
+	// count), the grid keeps this rank's window of them, and every later addParticles keeps only the particles
+	// of this rank's slab (clip), with the global running index as id (the ids of 1 process). add_region sets
+	// the start layout from its lattice counts first (plan); the first step re-cuts by the particle counts
+	// (the start rule) and moves particles to their owners.
 	void distribute(Grid<D>& g, size_t particles)
 	{
 		if (!distributed() || building) return;
@@ -38,8 +40,13 @@ public:
 		layout = SlabLayout<D>::balanced(std::vector<double>(size_t(SlabLayout<D>::layers(g)), 1.0), R); // even: one per layer
 		int lo, hi;
 		layout.reachedLayers(g, rank, lo, hi);
+		const double nodes = double(hi + 1 - lo) * double(g.stride[D - 1]), bytes = nodes * (sizeof(Node<D>) + 2),
+		             phys = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+		if (bytes > phys) // as the solver's constructor refuses a whole grid the machine cannot hold
+			throw InputError("mpiDistribute: this rank's grid window of " + fmtNum(nodes) + " nodes needs " + fmtNum(bytes / 1e9) + " GB, more than this machine's "
+			                 + fmtNum(phys / 1e9) + " GB of memory; use more ranks, fewer cells or a larger spacing");
 		g.setWindow(lo, hi + 1);
-		malloc_trim(0);                        // the whole grid's arrays go back to the system
+		malloc_trim(0);                        // the whole grid's arrays (if it was allocated) go back to the system
 		mallopt(M_MMAP_THRESHOLD, 1 << 20); // fixed: arrays ≥ 1 MB are mapped and go back when freed (no heap high-water)
 		building = true;
 	}

@@ -6,9 +6,12 @@ from .fields import SYM_NAMES, dim_of
 from .geometry import _corners, _holes, _integer, _number, fill_region, fill_region_chunks
 
 
-def make_solver(lo, hi, spacing, margin=2, shift=None):
+def make_solver(lo, hi, spacing, margin=2, shift=None, distribute=False):
     """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
     on every side, with grid spacing l = spacing [m].
+    distribute: True → under MPI with more than one rank, distributed construction from the start
+    (yade_mpm.parallel.distribute: each rank builds only its slab) and the grid is never allocated whole
+    on any rank (only this rank's node layers); on 1 process nothing changes.
     shift: per axis, a fraction of a cell in [0, 1) by which the grid's nodes are moved towards −axis
     (None: no shift): the same scene cut differently by the grid, to measure how much a result depends on
     where the grid cuts it (one more cell is added on a shifted axis, so [lo, hi] stays covered). A boundary
@@ -23,8 +26,10 @@ def make_solver(lo, hi, spacing, margin=2, shift=None):
             raise ValueError(f"shift = {shift!r}: expected {len(lo)} fractions of a cell, each in [0, 1)")
     cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin) + (frac > 0)
     origin = lo - (margin + frac) * spacing
+    if not isinstance(distribute, (bool, np.bool_)):
+        raise ValueError(f"make_solver: distribute = {distribute!r} must be True or False")
     cls = _core.Solver2D if len(lo) == 2 else _core.Solver3D
-    return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells))
+    return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells), distribute=bool(distribute))
 
 
 def check_setting(name, value, option=None):
