@@ -116,6 +116,14 @@ for counts, words in (([1.0], "counts has 1 entries"), ([-1.0] * 5, "counts[0] =
         raise AssertionError(f"_mpiPlan({counts}) was not refused")
     except ValueError as e:
         assert words in str(e), str(e)
+ym.add_region(s, mat, (0.0, 0.0), (0.2, 0.1))
+v = s.view("x0") if rank == 0 else None           # a view alive on rank 0 only: every rank refuses, none hangs
+try:
+    ym.add_region(s, mat, (0.0, 0.1), (0.2, 0.2))
+    raise AssertionError("add_region with a live view on rank 0 was not refused")
+except ValueError as e:
+    assert "del v" in str(e), str(e)
+del v
 print(f"rank {rank} OK", flush=True)
 """
 

@@ -75,8 +75,9 @@ public:
 	// Distributed construction, before a region's particles are added (add_region counts them first): count[c]
 	// = the region's particles in block layer c, the same on every rank (checked). The scene's first particles
 	// set the start layout from their counts (SlabLayout::balanced: each rank starts near N/R, the first step
-	// moves few particles) and the grid window; every region reserves this rank's share of it at once.
-	void plan(Grid<D>& g, Particles<D>& P, const std::vector<double>& count)
+	// moves few particles) and the grid window; every region reserves this rank's share of it at once, which
+	// moves the arrays: refused on every rank while a NumPy view of them is alive on any (liveViews).
+	void plan(Grid<D>& g, Particles<D>& P, const std::vector<double>& count, size_t liveViews)
 	{
 		const int L = SlabLayout<D>::layers(g);
 		if (!building) throw InputError("mpiPlan: the solver is not under distributed construction (yade_mpm.parallel.distribute)");
@@ -88,8 +89,12 @@ public:
 			sum[0] += count[size_t(c)], sum[1] += count[size_t(c)] * (c + 1);
 		}
 		neg[0] = -sum[0], neg[1] = -sum[1];
-		Comm::max(sum, 2), Comm::max(neg, 2);
+		double views = double(liveViews);
+		Comm::max(sum, 2), Comm::max(neg, 2), Comm::max(&views, 1);
 		if (sum[0] != -neg[0] || sum[1] != -neg[1]) throw InputError("mpiPlan: the ranks passed different counts (every rank must count the whole region)");
+		if (views > 0)
+			throw InputError("add_region: NumPy view(s) of the particle arrays are alive (" + fmtNum(views) + " on some rank) and adding particles under "
+			                 "distributed construction moves the arrays they point to; delete the views first (del v)");
 		if (builtIds == 0) {
 			layout = SlabLayout<D>::balanced(count, R);
 			int lo, hi;

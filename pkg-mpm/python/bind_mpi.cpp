@@ -120,7 +120,7 @@ void mpiPlan(Solver<D>& s, bp::object counts)
 {
 	std::vector<double> c(size_t(bp::len(counts)));
 	for (size_t k = 0; k < c.size(); ++k) c[k] = bp::extract<double>(counts[k]);
-	s.dd.plan(s.grid, s.P, c);
+	s.dd.plan(s.grid, s.P, c, s.liveViews);
 }
 
 } // namespace
