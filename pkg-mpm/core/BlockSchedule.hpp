@@ -23,8 +23,7 @@ struct BlockSchedule {
 	std::vector<uint32_t> colour[1 << D];      // non-empty blocks per colour
 	std::vector<uint32_t> colourCum[1 << D];   // particles in colour[c][0..k), k = 0..size (thread shares)
 	std::vector<uint32_t> perm, count, key;    // sort work arrays (kept: no allocation while stepping)
-	std::vector<Real>     tmp;
-	std::vector<int64_t>  idTmp;
+	std::vector<Real>     tmp;                 // Particles::permute's buffer (fields, material indices and ids)
 
 	size_t blockCount() const
 	{
@@ -77,7 +76,7 @@ struct BlockSchedule {
 		start.assign(count.begin(), count.end());
 		perm.resize(P.n);
 		for (size_t p = 0; p < P.n; ++p) perm[count[key[p]]++] = uint32_t(p);
-		P.permute(perm, tmp, idTmp);
+		P.permute(perm, tmp);
 		buildColours();
 	}
 

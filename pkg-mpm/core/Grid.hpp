@@ -4,6 +4,7 @@
 #pragma once
 #include "MirrorPlanes.hpp"
 #include <algorithm>
+#include <climits>
 #include <set>
 #include <vector>
 
@@ -58,9 +59,11 @@ struct Grid {
 	MirrorPlanes<D> mirrors; // the Slip planes (fold/unfold of the reflected images)
 
 	Grid() = default;
-	Grid(const Vec& o, Real h, const IVec& n) { init(o, h, n); }
+	Grid(const Vec& o, Real h, const IVec& n, int lo = 0, int hi = INT_MAX) { init(o, h, n, lo, hi); }
 
-	void init(const Vec& o, Real h, const IVec& n)
+	// The grid of n cells from o; the node arrays hold the stored layers [lo, hi) along the last axis (clamped;
+	// default: all; an MPI rank of a distributed construction starts with one layer and never holds the whole grid).
+	void init(const Vec& o, Real h, const IVec& n, int lo = 0, int hi = INT_MAX)
 	{
 		for (int a = 0; a < D; ++a) {
 			requireFinite(o[a], "grid origin");
@@ -77,7 +80,9 @@ struct Grid {
 			s *= stored[a];
 		}
 		for (int a = D; a < 3; ++a) stride[a] = 0;
-		layer0 = 0, layerEnd = int(stored[D - 1]), offset = 0;
+		layer0 = std::max(lo, 0), layerEnd = std::min(hi, int(stored[D - 1]));
+		if (!(layer0 < layerEnd)) throw InputError("grid window: empty layer range [" + std::to_string(lo) + ", " + std::to_string(hi) + ")");
+		offset = size_t(layer0) * stride[D - 1], s = size_t(layerEnd - layer0) * stride[D - 1];
 		allocate(s);
 		excluded.assign(s, 0);
 		gapNodes.clear();
@@ -259,11 +264,17 @@ struct Grid {
 	}
 
 private:
+	// Node arrays of exactly s zeroed nodes. The old arrays are freed first: assign would keep their capacity, so
+	// a window narrowed from the whole grid (MPI, setWindow) would still hold the whole grid's pages.
 	void allocate(size_t s)
 	{
-		nodes.assign(s, Node<D> {});
-		vel.assign(s, NodeVec<D> {}), vold.assign(s, NodeVec<D> {}), mom.assign(s, NodeVec<D> {}), vmusl.assign(s, NodeVec<D> {});
-		fixMask.assign(s, 0);
+		fresh(nodes, s), fresh(vel, s), fresh(vold, s), fresh(mom, s), fresh(vmusl, s), fresh(fixMask, s);
+	}
+	template <class V>
+	static void fresh(V& v, size_t s)
+	{
+		V().swap(v);
+		v.resize(s); // value-initialised: zero
 	}
 	static std::string num(Real v)
 	{

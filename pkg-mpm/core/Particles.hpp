@@ -3,6 +3,7 @@
 // their contents in place.
 #pragma once
 #include "SymTensor.hpp"
+#include <cstring>
 #include <vector>
 
 namespace mpm {
@@ -200,19 +201,20 @@ struct Particles {
 	}
 
 	// Applies particle order perm (new slot k holds old particle perm[k]) to every field.
-	// tmp, idTmp: work buffers kept by the caller, so a re-sort allocates nothing once they have grown.
-	void permute(const std::vector<uint32_t>& perm, std::vector<Real>& tmp, std::vector<int64_t>& idTmp)
+	// tmp: a work buffer kept by the caller, so a re-sort allocates nothing once it has grown; the material
+	// indices and ids pass through it too (the ids' 64 bits copied as they are): one buffer, not two.
+	void permute(const std::vector<uint32_t>& perm, std::vector<Real>& tmp)
 	{
+		static_assert(sizeof(int64_t) == sizeof(Real), "an id must fit a slot of the work buffer");
 		tmp.resize(n);
 		forEachRealField([&](std::vector<Real>& a) {
 			for (size_t k = 0; k < n; ++k) tmp[k] = a[perm[k]];
 			std::copy(tmp.begin(), tmp.begin() + n, a.begin());
 		});
-		idTmp.resize(n);
-		for (size_t k = 0; k < n; ++k) idTmp[k] = mat[perm[k]];
-		for (size_t k = 0; k < n; ++k) mat[k] = uint8_t(idTmp[k]);
-		for (size_t k = 0; k < n; ++k) idTmp[k] = id[perm[k]];
-		std::copy(idTmp.begin(), idTmp.begin() + n, id.begin()); // keep the buffer: Python views must stay valid
+		for (size_t k = 0; k < n; ++k) tmp[k] = Real(mat[perm[k]]);
+		for (size_t k = 0; k < n; ++k) mat[k] = uint8_t(tmp[k]);
+		for (size_t k = 0; k < n; ++k) std::memcpy(&tmp[k], &id[perm[k]], sizeof(int64_t));
+		if (n) std::memcpy(id.data(), tmp.data(), n * sizeof(int64_t)); // in place: Python views must stay valid
 	}
 	size_t bytesPerParticle() const
 	{

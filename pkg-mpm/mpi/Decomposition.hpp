@@ -4,13 +4,17 @@
 // (HaloExchange), the Δt limits are global, and a phase that failed on one rank stops every rank.
 #pragma once
 #include "HaloExchange.hpp"
+#include "ParticlePack.hpp"
 #include <malloc.h>
+#include <unistd.h>
 
 #ifdef MPM_MPI
 namespace mpm {
 
 template <int D>
 class Decomposition {
+	using Pack = ParticlePack<D>;
+
 public:
 	const int       rank = Comm::rank(), R = Comm::size();
 	SlabLayout<D>   layout;
@@ -23,9 +27,10 @@ public:
 
 	bool distributed() const { return R > 1; }
 	// Distributed construction, before any particle exists: the slabs start evenly (block layers split by
-	// count, SlabLayout::even), the grid keeps this rank's window of them, and every later addParticles keeps
-	// only the particles of this rank's slab (clip), with the global running index as id (the ids of 1 process).
-	// The first step re-cuts by the particle counts (the start rule) and moves particles to their owners.
+	// count), the grid keeps this rank's window of them, and every later addParticles keeps only the particles
+	// of this rank's slab (clip), with the global running index as id (the ids of 1 process). add_region sets
+	// the start layout from its lattice counts first (plan); the first step re-cuts by the particle counts
+	// (the start rule) and moves particles to their owners.
 	void distribute(Grid<D>& g, size_t particles)
 	{
 		if (!distributed() || building) return;
@@ -35,8 +40,13 @@ public:
 		layout = SlabLayout<D>::balanced(std::vector<double>(size_t(SlabLayout<D>::layers(g)), 1.0), R); // even: one per layer
 		int lo, hi;
 		layout.reachedLayers(g, rank, lo, hi);
+		const double nodes = double(hi + 1 - lo) * double(g.stride[D - 1]), bytes = nodes * (sizeof(Node<D>) + 2),
+		             phys = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+		if (bytes > phys) // as the solver's constructor refuses a whole grid the machine cannot hold
+			throw InputError("mpiDistribute: this rank's grid window of " + fmtNum(nodes) + " nodes needs " + fmtNum(bytes / 1e9) + " GB, more than this machine's "
+			                 + fmtNum(phys / 1e9) + " GB of memory; use more ranks, fewer cells or a larger spacing");
 		g.setWindow(lo, hi + 1);
-		malloc_trim(0);                        // the whole grid's arrays go back to the system
+		malloc_trim(0);                        // the whole grid's arrays (if it was allocated) go back to the system
 		mallopt(M_MMAP_THRESHOLD, 1 << 20); // fixed: arrays ≥ 1 MB are mapped and go back when freed (no heap high-water)
 		building = true;
 	}
@@ -61,6 +71,40 @@ public:
 		P.append(xk.data(), vk.data(), mk.data(), kept.size(), g.origin, g.upper(), material);
 		for (size_t k = 0; k < kept.size(); ++k) P.id[old + k] = int64_t(first + kept[k]); // the id of 1 process
 		return true;
+	}
+	// Distributed construction, before a region's particles are added (add_region counts them first): count[c]
+	// = the region's particles in block layer c, the same on every rank (checked). The scene's first particles
+	// set the start layout from their counts (SlabLayout::balanced: each rank starts near N/R, the first step
+	// moves few particles) and the grid window; every region reserves this rank's share of it at once, which
+	// moves the arrays: refused on every rank while a NumPy view of them is alive on any (liveViews).
+	void plan(Grid<D>& g, Particles<D>& P, const std::vector<double>& count, size_t liveViews)
+	{
+		const int L = SlabLayout<D>::layers(g);
+		if (!building) throw InputError("mpiPlan: the solver is not under distributed construction (yade_mpm.parallel.distribute)");
+		if (int(count.size()) != L) throw InputError("mpiPlan: counts has " + std::to_string(count.size()) + " entries; expected " + std::to_string(L) + " (one per block layer)");
+		double sum[2] = { 0, 0 }, neg[2];
+		for (int c = 0; c < L; ++c) {
+			if (!(count[size_t(c)] >= 0 && std::isfinite(count[size_t(c)])))
+				throw InputError("mpiPlan: counts[" + std::to_string(c) + "] = " + fmtNum(count[size_t(c)]) + " must be a finite count in [0, inf)");
+			sum[0] += count[size_t(c)], sum[1] += count[size_t(c)] * (c + 1);
+		}
+		neg[0] = -sum[0], neg[1] = -sum[1];
+		double views = double(liveViews);
+		Comm::max(sum, 2), Comm::max(neg, 2), Comm::max(&views, 1);
+		if (sum[0] != -neg[0] || sum[1] != -neg[1]) throw InputError("mpiPlan: the ranks passed different counts (every rank must count the whole region)");
+		if (views > 0)
+			throw InputError("add_region: NumPy view(s) of the particle arrays are alive (" + fmtNum(views) + " on some rank) and adding particles under "
+			                 "distributed construction moves the arrays they point to; delete the views first (del v)");
+		if (builtIds == 0) {
+			layout = SlabLayout<D>::balanced(count, R);
+			int lo, hi;
+			layout.reachedLayers(g, rank, lo, hi);
+			g.setWindow(lo, hi + 1);
+			malloc_trim(0);
+		}
+		double own = 0;
+		for (int c = layout.first[size_t(rank)]; c < layout.first[size_t(rank) + 1]; ++c) own += count[size_t(c)];
+		P.reserve(P.n + size_t(own)); // the arrays grow once per region (appendOwn's chunks then fit)
 	}
 	bool needsSplit() const { return R > 1 && !decomposed; } // the first step on > 1 rank always sorts (and splits)
 
@@ -100,7 +144,7 @@ public:
 		layout = L;
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = n; p < P.n; ++p) go[p] = 1;
-		keep(P, go);
+		Pack::keep(P, go);
 		settle(g);
 	}
 	// Before the counting sort: the first call splits the (replicated) scene, later calls re-balance (when the
@@ -170,7 +214,7 @@ public:
 		if (!strict && Comm::all(nd + nu == 0)) return false;
 		double opt[3] = { double(P.hasTraction()), double(P.hasDamageState()), double(!P.nFlaw.empty()) };
 		Comm::max(opt, 3); // the optional fields some rank holds: every rank sends and receives them (zero where absent)
-		ensureFields(P, opt);
+		Pack::ensureFields(P, opt);
 		const size_t nf = size_t(2 + 2 * D + D * D + 3 + Particles<D>::NS) + size_t(opt[0] > 0) * D + size_t(opt[1] > 0) * 3 + size_t(opt[2] > 0);
 		std::vector<double> sd, su, rd, ru;
 		while (true) { // rounds of at most `batch` particles per direction (one round unless many move)
@@ -180,11 +224,11 @@ public:
 			const size_t ad = rank > 0 ? size_t(rd[0]) : 0, au = rank + 1 < R ? size_t(ru[0]) : 0;
 			sd.clear(), su.clear(), sd.reserve(nd * nf), su.reserve(nu * nf);
 			for (size_t p = 0; p < P.n; ++p)
-				if (go[p]) pack(P, p, go[p] == 1 ? sd : su);
+				if (go[p]) Pack::pack(P, p, go[p] == 1 ? sd : su);
 			rd.assign(ad * nf, 0.0), ru.assign(au * nf, 0.0);
 			Comm::neighbours(rank - 1, rank + 1, sd, rd, su, ru);
-			keep(P, go);
-			unpack(P, rd, ad, nf, opt), unpack(P, ru, au, nf, opt); // arrivals from below, then from above: a fixed order
+			Pack::keep(P, go);
+			Pack::unpack(P, rd, ad, nf, opt), Pack::unpack(P, ru, au, nf, opt); // arrivals from below, then from above: a fixed order
 			migrated += nd + nu;
 			if (Comm::all(!more)) return true;
 			mark(g, P, go, ok, nd, nu, more);
@@ -277,7 +321,7 @@ private:
 		}
 		double s = 0;
 		for (size_t p = 0; p < P.n; ++p) s += P.x[D - 1][p] + 0.5 * P.x[0][p] + 1e-3 * double(P.id[p]);
-		double hiv[3] = { double(P.n), s, double(fieldCount(P)) }, lov[3] = { -hiv[0], -hiv[1], -hiv[2] };
+		double hiv[3] = { double(P.n), s, double(Pack::fieldCount(P)) }, lov[3] = { -hiv[0], -hiv[1], -hiv[2] };
 		Comm::max(hiv, 3), Comm::max(lov, 3);
 		if (hiv[0] != -lov[0] || hiv[1] != -lov[1] || hiv[2] != -lov[2])
 			throw InputError("MPI: every rank must build the same scene before the first step (the script runs on every rank); the ranks hold "
@@ -286,7 +330,7 @@ private:
 		layout.checkMirrors(g);
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = 0; p < P.n; ++p) go[p] = layout.owner(SlabLayout<D>::layerOf(g, P.x[D - 1][p])) != rank;
-		keep(P, go);
+		Pack::keep(P, go);
 		P.shrink(); // the other ranks' particles: their memory goes back
 		settle(g);
 	}
@@ -314,60 +358,6 @@ private:
 	}
 	size_t              ownedLo = 0, ownedHi = 0; // nodes counted by this rank in sums over nodes (ownsNode)
 	std::vector<double> gathered;                 // scratch of sumInRankOrder
-	static size_t fieldCount(Particles<D>& P)
-	{
-		size_t n = 2; // id, material
-		P.forEachRealField([&](std::vector<Real>&) { ++n; });
-		return n;
-	}
-	static void pack(Particles<D>& P, size_t p, std::vector<double>& buf)
-	{
-		P.forEachRealField([&](std::vector<Real>& f) { buf.push_back(f[p]); });
-		double id;
-		std::memcpy(&id, &P.id[p], sizeof id); // the 64 bits as they are
-		buf.push_back(id), buf.push_back(double(P.mat[p]));
-	}
-	// Keeps the particles with go[p] == 0, in their order.
-	static void keep(Particles<D>& P, const std::vector<uint8_t>& go)
-	{
-		size_t k = 0;
-		auto   compact = [&](auto& f) {
-			k = 0;
-			for (size_t p = 0; p < P.n; ++p)
-				if (!go[p]) f[k++] = f[p];
-			f.resize(k);
-		};
-		P.forEachRealField(compact);
-		compact(P.id), compact(P.mat);
-		P.n = k;
-	}
-	// The optional fields flagged in opt (traction, damage state, flaw counts), zero-filled where missing.
-	static void ensureFields(Particles<D>& P, const double* opt)
-	{
-		if (opt[0] > 0 && !P.hasTraction())
-			for (int a = 0; a < D; ++a) P.trac[a].assign(P.n, 0.0);
-		if (opt[1] > 0 && !P.hasDamageState())
-			for (auto* f : { &P.epsP, &P.damage, &P.eps0 }) f->assign(P.n, 0.0);
-		if (opt[2] > 0 && P.nFlaw.empty()) P.nFlaw.assign(P.n, 0.0);
-	}
-	static void unpack(Particles<D>& P, const std::vector<double>& buf, size_t count, size_t nf, const double* opt)
-	{
-		if (!count) return;
-		const size_t n0 = P.n;
-		P.n += count;
-		ensureFields(P, opt); // a rank without particles had none of them (empty arrays)
-		size_t i = 0; // field index, in pack's order
-		P.forEachRealField([&](std::vector<Real>& f) {
-			f.reserve(P.n), f.resize(P.n); // exact growth (no doubling)
-			for (size_t j = 0; j < count; ++j) f[n0 + j] = buf[j * nf + i];
-			++i;
-		});
-		P.id.reserve(P.n), P.mat.reserve(P.n), P.id.resize(P.n), P.mat.resize(P.n);
-		for (size_t j = 0; j < count; ++j) {
-			std::memcpy(&P.id[n0 + j], &buf[j * nf + i], sizeof(int64_t));
-			P.mat[n0 + j] = uint8_t(buf[j * nf + i + 1]);
-		}
-	}
 };
 
 } // namespace mpm

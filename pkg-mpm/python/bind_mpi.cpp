@@ -99,6 +99,30 @@ void mpiDistribute(Solver<D>& s)
 	s.dd.distribute(s.grid, s.P.n);
 }
 
+// Particles of the positions (N, D) per block layer along the slab axis (non-finite: layer 0, rank 0's, as
+// Decomposition::appendOwn keeps them): the counts of a region before it is added (yade_mpm.add_region).
+template <int D>
+bp::list mpiLayerCounts(Solver<D>& s, bp::object pos)
+{
+	np::ndarray         x = asDoubleArray(pos, "positions", D);
+	const double*       p = reinterpret_cast<const double*>(x.get_data());
+	std::vector<double> count(size_t(SlabLayout<D>::layers(s.grid)), 0.0);
+	for (size_t k = 0, n = size_t(x.shape(0)); k < n; ++k) {
+		const double z = p[k * D + D - 1];
+		count[std::isfinite(z) ? size_t(SlabLayout<D>::layerOf(s.grid, z)) : 0] += 1;
+	}
+	bp::list out;
+	for (double c : count) out.append(c);
+	return out;
+}
+template <int D>
+void mpiPlan(Solver<D>& s, bp::object counts)
+{
+	std::vector<double> c(size_t(bp::len(counts)));
+	for (size_t k = 0; k < c.size(); ++k) c[k] = bp::extract<double>(counts[k]);
+	s.dd.plan(s.grid, s.P, c, s.liveViews);
+}
+
 } // namespace
 
 // MPI_Init_thread at import (one thread per rank calls MPI: FUNNELED); MPI_Finalize when Python exits.
@@ -125,6 +149,10 @@ void exposeMpi(SolverClass<D>& cls, const char*)
 	cls.def("mpiInfo", &mpiInfo<D>, "MPI decomposition of this solver: rank, size, firstLayers, local particles, migrated, rebalances, imbalance, haloBytesSent; memory: heldLayers, gridNodes, gridBytes, particleBytes, peakRSS [B].");
 	cls.def("_mpiDistribute", &mpiDistribute<D>,
 	        "Distributed construction (yade_mpm.parallel.distribute): from now on each rank keeps only the particles of its slab; before adding any.");
+	cls.def("_mpiLayerCounts", &mpiLayerCounts<D>, "Distributed construction: particles of the positions (N, D) per block layer along the slab axis.");
+	cls.def("_mpiPlan", &mpiPlan<D>,
+	        "Distributed construction, before adding a region: its particle counts per block layer (the same on every rank); the first region sets the "
+	        "start layout and the grid window from them, every region reserves this rank's share.");
 	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, "Checkpoint resume: the saved slab layout and the rank's particle count (yade_mpm.checkpoint).");
 }
 template void exposeMpi<2>(SolverClass<2>&, const char*);

@@ -11,8 +11,15 @@ struct SolverWrap {
 	using S = Solver<D>;
 	static std::string who(const char* what) { return solverName(D) + ": " + what; }
 
-	static std::shared_ptr<S> make(bp::object origin, bp::object spacing, bp::object cells)
+	// distribute (MPI, > 1 rank): the grid starts with one node layer and Decomposition::distribute gives it this
+	// rank's window at once, so no rank ever allocates the whole grid (yade_mpm.make_solver(…, distribute=True)).
+	static std::shared_ptr<S> make(bp::object origin, bp::object spacing, bp::object cells, bp::object distribute)
 	{
+#ifdef MPM_MPI
+		const bool dist = argBool(distribute, who("distribute")) && Comm::size() > 1;
+#else
+		const bool dist = argBool(distribute, who("distribute")) && false; // the serial core: 1 process, the whole grid
+#endif
 		const auto o = toVec<D>(origin, who("origin"));
 		const Real h = argReal(spacing, who("spacing"), "m", 0, INFINITY, OO);
 		PyObject*  q = cells.ptr();
@@ -31,10 +38,13 @@ struct SolverWrap {
 		}
 		// Refuse a grid the machine cannot hold, with the numbers.
 		const double bytes = nodes * (sizeof(Node<D>) + 2), phys = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
-		if (bytes > phys)
+		if (bytes > phys && !dist)
 			throw InputError(who("cells") + ": a grid of " + ParamInfo::num(nodes) + " nodes needs " + ParamInfo::num(bytes / 1e9) + " GB, more than this machine's "
 			                 + ParamInfo::num(phys / 1e9) + " GB of memory; use fewer cells or a larger spacing");
-		return std::make_shared<S>(o, h, n);
+		if (!dist) return std::make_shared<S>(o, h, n);
+		auto s = std::make_shared<S>(o, h, n, 0, 1);
+		MPM_IF_MPI(s->dd.distribute(s->grid, 0);)
+		return s;
 	}
 	// Calls f(material) with the ElasticMat or DpGkMat inside m, or refuses m naming `what`.
 	template <class F>
@@ -171,7 +181,7 @@ struct SolverWrap {
 
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
-		cls.def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"))))
+		cls.def("__init__", bp::make_constructor(&make, bp::default_call_policies(), (bp::arg("origin"), bp::arg("spacing"), bp::arg("cells"), bp::arg("distribute") = false)))
 		        .def("_addParticles", &addParticles, (bp::arg("positions"), bp::arg("volumes"), bp::arg("masses"), bp::arg("material") = 0),
 		             "Adds particles (positions (N, D) [m], volumes [m³], masses [kg]) of material index `material` (addMaterial's return value).")
 		        .def("_addMaterial", &addMaterial, bp::arg("material"), "Adds an ElasticMat or DpGkMat to the scene; returns its index for addParticles.")

@@ -57,7 +57,9 @@ public:
 	void   viewOpened() { ++liveViews, viewTaken = true; }
 	void   viewClosed() { --liveViews; }
 
-	Solver(const Vec& origin, Real spacing, const IVec& cells) : grid(origin, spacing, cells), xfer(grid, P, sched)
+	// layerLo, layerHi: the grid's node arrays hold these stored layers along the last axis (Grid::init; default all)
+	Solver(const Vec& origin, Real spacing, const IVec& cells, int layerLo = 0, int layerHi = INT_MAX)
+	    : grid(origin, spacing, cells, layerLo, layerHi), xfer(grid, P, sched)
 	{
 		materials.setCell(grid.spacing);
 		MPM_IF_MPI(exchange.dd = &dd;) // MPI: the step's shared-node sums and the contact's reductions over the ranks

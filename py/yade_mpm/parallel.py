@@ -10,8 +10,9 @@ instead when
 
 Under ``srun`` (Slurm) set ``YADE_MPM_MPI=1``. Every rank runs the same script. By default every rank builds
 the same scene and the first step keeps each rank's slab of particles (pkg-mpm/mpi/Decomposition.hpp);
-``distribute(solver)`` right after creating the solver makes each rank build only its slab (a scene larger
-than one process can hold; doc/guide/mpi.md).
+``make_solver(…, distribute=True)``, or ``distribute(solver)`` right after creating the solver, makes each rank
+build only its slab (a scene larger than one process can hold; doc/guide/mpi.md); the first never allocates
+the whole grid on a rank.
 """
 import os
 
@@ -59,9 +60,11 @@ def size():
 
 def distribute(solver):
     """Distributed construction: call right after creating the solver, before adding particles. Each rank then
-    holds only the grid layers of its slab (block layers split evenly) and keeps of every add_region /
-    addParticles only the particles of its slab, with the ids 1 process would give; the first step re-cuts the
-    slabs by the particle counts. Nothing happens on 1 process. Builders that need every particle on every
+    holds only the grid layers of its slab (block layers split evenly; the scene's first add_region sets the
+    slabs from its lattice counts) and keeps of every add_region / addParticles only the particles of its slab,
+    with the ids 1 process would give; the first step re-cuts the slabs by the particle counts. Nothing happens
+    on 1 process. The solver was created with the whole grid (freed here); make_solver(…, distribute=True)
+    never allocates it on a rank. Builders that need every particle on every
     rank refuse (add_region with thin gaps excluded, d0 = 'initial' bodies); a checkpoint resumes into the
     replicated build only."""
     if size() > 1:

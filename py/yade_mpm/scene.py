@@ -6,9 +6,12 @@ from .fields import SYM_NAMES, dim_of
 from .geometry import _corners, _holes, _integer, _number, fill_region, fill_region_chunks
 
 
-def make_solver(lo, hi, spacing, margin=2, shift=None):
+def make_solver(lo, hi, spacing, margin=2, shift=None, distribute=False):
     """Solver (2D if lo has 2 components, else 3D) whose grid covers [lo, hi] [m] plus `margin` cells
     on every side, with grid spacing l = spacing [m].
+    distribute: True → under MPI with more than one rank, distributed construction from the start
+    (yade_mpm.parallel.distribute: each rank builds only its slab) and the grid is never allocated whole
+    on any rank (only this rank's node layers); on 1 process nothing changes.
     shift: per axis, a fraction of a cell in [0, 1) by which the grid's nodes are moved towards −axis
     (None: no shift): the same scene cut differently by the grid, to measure how much a result depends on
     where the grid cuts it (one more cell is added on a shifted axis, so [lo, hi] stays covered). A boundary
@@ -23,8 +26,10 @@ def make_solver(lo, hi, spacing, margin=2, shift=None):
             raise ValueError(f"shift = {shift!r}: expected {len(lo)} fractions of a cell, each in [0, 1)")
     cells = np.ceil((hi - lo) / spacing - 1e-9).astype(int) + 2 * int(margin) + (frac > 0)
     origin = lo - (margin + frac) * spacing
+    if not isinstance(distribute, (bool, np.bool_)):
+        raise ValueError(f"make_solver: distribute = {distribute!r} must be True or False")
     cls = _core.Solver2D if len(lo) == 2 else _core.Solver3D
-    return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells))
+    return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells), distribute=bool(distribute))
 
 
 def check_setting(name, value, option=None):
@@ -77,7 +82,8 @@ def add_region(solver, material, lo, hi, ppc=2, holes=(), keep=None, gap_nodes="
     """Fill [lo, hi] minus holes with particles of `material` (ppc per cell per axis, default 2).
     Each region keeps its own material (several materials per scene, e.g. rock with an elastic infill):
     the material is added to the solver (an identical one already there is reused) and the damage
-    thresholds of the new particles follow from it. Returns the ids of the new particles.
+    thresholds of the new particles follow from it. Returns the ids of the new particles (an array; under
+    yade_mpm.parallel.distribute a `range` of the same ids, so no rank holds an array of every particle's id).
 
     gap_nodes: "excluded" (default) takes the grid nodes inside thin holes (a flaw or hole narrower than
     the cubic B-spline support, 4 cells) out of the WLS fits, so the two faces are not tied through
@@ -109,20 +115,29 @@ def _distributed(solver):
 def _add_region_distributed(solver, material, lo, hi, ppc, holes, keep, gap_nodes):
     """add_region under distributed construction: the lattice in chunks of slices along x (at most about
     CHUNK particles each, in the order of fill_region), each rank keeping its slab's particles (the core clips;
-    ids are the running index over all ranks, as on 1 process). Returns the global ids of the new particles."""
+    ids are the running index over all ranks, as on 1 process). The lattice is generated twice (`keep` is
+    called twice per chunk): first its particles are counted per block layer, so the scene's first region
+    sets the ranks' start layout from them (each rank starts near N/R particles) and each rank reserves its
+    share at once; then it is added. Returns the global ids of the new particles as a range (an array of them
+    would hold 8 bytes per particle of the whole region on every rank)."""
     if gap_nodes == "excluded" and any(is_thin(h, solver.spacing) for h in _holes(holes, dim_of(solver))):
         raise ValueError("add_region: gap_nodes = 'excluded' with a thin hole needs every particle near the gap on every rank; under "
                          "yade_mpm.parallel.distribute use gap_nodes = 'shared', or build the scene without distribute")
+    counts = None
+    for x, _ in fill_region_chunks(lo, hi, solver.spacing, ppc, holes, keep, CHUNK):
+        c = np.asarray(solver._mpiLayerCounts(x))
+        counts = c if counts is None else counts + c
+    if counts is None:
+        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
     index = material_index(solver, material)
     first = int(solver.mpiInfo()["builtParticles"])
+    solver._mpiPlan(counts.tolist())
     total = 0
     for x, v in fill_region_chunks(lo, hi, solver.spacing, ppc, holes, keep, CHUNK):   # fill_region's points and order
         solver._addParticles(x, np.full(len(x), v), np.full(len(x), v * material.density), material=index)
         total += len(x)
         del x
-    if total == 0:
-        raise ValueError("the region holds no particles (holes cover it or it is smaller than a sub-cell)")
-    return np.arange(first, first + total)
+    return range(first, first + total)
 
 
 CHUNK = 1 << 17   # particles generated at once by a distributed add_region (every rank generates every chunk)

@@ -24,14 +24,12 @@ def build_scene(dim, material, cells, distribute=False):
     """The benchmark block: rock on a fixed floor with slip side walls, deformed by an initial
     pure-shear velocity field v = ε̇ (x − x_c) along x and −ε̇ (y − y_c) along y, so the stress grows
     to the DP–GK yield and damage thresholds within the warm-up. Returns the solver. distribute: under
-    MPI each rank builds only its slab (yade_mpm.parallel.distribute)."""
+    MPI each rank builds only its slab (make_solver(…, distribute=True))."""
     import yade_mpm as ym
     from yade_mpm import rocks
     size = [c * SPACING for c in cells]
     lo, hi = (0.0,) * dim, tuple(size)
-    s = ym.make_solver(lo, hi, SPACING, margin=3)
-    if distribute:
-        ym.parallel.distribute(s)
+    s = ym.make_solver(lo, hi, SPACING, margin=3, distribute=distribute)   # under MPI: no rank allocates the whole grid
     # the paper's granite (Sec. 3.1), elastic or with the DP–GK parameters of Sec. 3.2: at this strain
     # rate most particles yield and damage during the timed steps
     mat = rocks.granite() if material == "elastic" else rocks.granite_dpgk()
