@@ -69,7 +69,12 @@ def main():
     ap.add_argument("--spacings", default="0.002", help="MPM grid spacings [m], comma list (default %(default)s)")
     ap.add_argument("--courants", default="1,0.5,0.25,0.125", help="Courant numbers, comma list (default %(default)s)")
     ap.add_argument("--fem-spacings", default="0.001,0.0005,0.00025", help="FEM mesh spacings [m], each half the last (default %(default)s)")
+    ap.add_argument("--runs", default=",".join(RUNS), help="MPM runs, comma list of: " + ", ".join(RUNS) + " (default: all)")
     a = ap.parse_args()
+    names = [x.strip() for x in a.runs.split(",") if x.strip()]
+    bad = [x for x in names if x not in RUNS]
+    if bad or not names:
+        raise SystemExit(f"--runs: {bad or 'none given'}; choose from: {', '.join(RUNS)}")
     spacings = [float(x) for x in a.spacings.split(",")]
     courants = [ym.scene.check_courant(float(x)) for x in a.courants.split(",")]
     fem_h = [float(x) for x in a.fem_spacings.split(",")]
@@ -84,15 +89,22 @@ def main():
         rich = uncertainty.richardson(fem_h, vals) if len(vals) >= 3 else dict(limit=None, order=None)
         fem[kind] = dict(spacings_m=fem_h, modulus_Pa=vals, limit_Pa=rich["limit"] or vals[-1], order=rich["order"])
         print(f"[fem] {kind}: " + ", ".join(f"{v / plane:.5f}" for v in vals) + f" × E/(1−ν²); limit {fem[kind]['limit_Pa'] / plane:.5f}", flush=True)
-    runs = []
+    runs, failed = [], []
     for l in spacings:
-        for name in RUNS:
+        for name in names:
             for C in courants:
-                r = mpm_modulus(name, l, C)
+                try:   # a failed run is recorded with its reason and the next one runs
+                    r = mpm_modulus(name, l, C)
+                except Exception as e:   # noqa: BLE001 (the reason goes to summary.json)
+                    failed.append(dict(run=name, spacing_m=l, courant=C, reason=f"{type(e).__name__}: {e}"))
+                    print(f"[mpm] {name} l = {l * 1e3:g} mm C = {C:g}: FAILED ({failed[-1]['reason']})", flush=True)
+                    continue
                 runs.append(r)
                 print(f"[mpm] {name} l = {l * 1e3:g} mm C = {C:g}: platen {r['platen_modulus_Pa'] / plane:.5f}, own strain "
                       f"{r['own_modulus_Pa'] / plane:.5f} × E/(1−ν²) (settled {r['settled']}, {r['wall_s']:.0f} s)", flush=True)
-    json.dump(dict(plane_strain_modulus_Pa=plane, fem=fem, runs=runs), open(os.path.join(a.out, "summary.json"), "w"), indent=1)
+                json.dump(dict(plane_strain_modulus_Pa=plane, fem=fem, runs=runs, failed=failed), open(os.path.join(a.out, "summary.json"), "w"),
+                          indent=1)   # after every run: an interrupted study keeps what it has
+    json.dump(dict(plane_strain_modulus_Pa=plane, fem=fem, runs=runs, failed=failed), open(os.path.join(a.out, "summary.json"), "w"), indent=1)
     lo, hi = fem["open"]["limit_Pa"], fem["bonded"]["limit_Pa"]
     lines = [f"FEM (P1, Richardson over {', '.join(f'{h * 1e3:g}' for h in fem_h)} mm): open {lo / plane:.5f}, bonded {hi / plane:.5f} × E/(1−ν²).", "",
              "E′ = E/(1 − ν²). *÷ intact*: the modulus over the same grid's and C's intact specimen (the FEM intact is E′ exactly), which "
@@ -105,6 +117,7 @@ def main():
         rel = r["platen_modulus_Pa"] / ref[0] if ref else math.nan
         lines.append(f"| {r['run']} | {r['spacing_m'] * 1e3:g} | {r['courant']:g} | {r['platen_modulus_Pa'] / plane:.5f} | {r['own_modulus_Pa'] / plane:.5f} | "
                      f"{rel:.5f} | {lo / plane:.4f} … {hi / plane:.4f} | {np.ptp(same) / np.mean(same):.2%} |")
+    lines += [f"\nFailed: {f['run']} l = {f['spacing_m'] * 1e3:g} mm C = {f['courant']:g}: {f['reason']}" for f in failed]
     open(os.path.join(a.out, "table.md"), "w").write("\n".join(lines) + "\n")
     print("\n".join(lines))
 
