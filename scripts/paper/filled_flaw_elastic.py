@@ -69,9 +69,9 @@ def main():
     ap.add_argument("--spacings", default="0.002", help="MPM grid spacings [m], comma list (default %(default)s)")
     ap.add_argument("--courants", default="1,0.5,0.25,0.125", help="Courant numbers, comma list (default %(default)s)")
     ap.add_argument("--fem-spacings", default="0.001,0.0005,0.00025", help="FEM mesh spacings [m], each half the last (default %(default)s)")
-    ap.add_argument("--runs", default=",".join(RUNS), help="MPM runs, comma list of: " + ", ".join(RUNS) + " (default: all)")
+    ap.add_argument("--runs", default=";".join(RUNS), help="MPM runs, a ';' list of: " + "; ".join(RUNS) + " (default: all)")
     a = ap.parse_args()
-    names = [x.strip() for x in a.runs.split(",") if x.strip()]
+    names = [x.strip() for x in a.runs.split(";") if x.strip()]
     bad = [x for x in names if x not in RUNS]
     if bad or not names:
         raise SystemExit(f"--runs: {bad or 'none given'}; choose from: {', '.join(RUNS)}")
