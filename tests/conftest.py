@@ -16,11 +16,11 @@ TOPICS = {
                 "test_contact_kinematic", "test_contact_matrix", "test_contact_stick", "test_courant", "test_damage_threshold",
                 "test_determinism", "test_dpgk", "test_dpgk_damage", "test_elastic_dynamics", "test_multimaterial", "test_outside",
                 "test_checkpoint", "test_hybrid", "test_yade_hook", "test_examples", "test_pic_dissipation"],
-    "paper": ["test_bonded", "test_case_results", "test_circular_opening", "test_fidelity", "test_penny_crack", "test_penny_prism",
+    "paper": ["test_bonded", "test_filled_flaw_fem", "test_case_results", "test_circular_opening", "test_fidelity", "test_penny_crack", "test_penny_prism",
               "test_report", "test_scripts_smoke", "test_slab3d", "test_stability", "test_studies", "test_tunnel", "test_tunnel_script"],
     "mpi": ["test_mpi", "test_mpi_checkpoint", "test_mpi_contact", "test_mpi_outside", "test_mpi_rebalance", "test_mpi_spheres", "test_mpi_distributed", "test_mpi_memory"],
 }
-SLOW = {"test_contact_matrix", "test_studies", "test_contact_params", "test_scripts_smoke", "test_contact_kinematic",
+SLOW = {"test_filled_flaw_fem", "test_contact_matrix", "test_studies", "test_contact_params", "test_scripts_smoke", "test_contact_kinematic",
         "test_contact_corners", "test_tunnel_script", "test_mpi_contact", "test_slab3d", "test_mpi_spheres", "test_circular_opening",
         "test_penny_prism", "test_examples"}
 _TOPIC_OF = {f: t for t, files in TOPICS.items() for f in files}

@@ -7,15 +7,12 @@ between the two FEM values; one whose cohesion never lets it slip must equal the
     /usr/bin/python3 scripts/paper/filled_flaw_elastic.py --out out/filled_flaw_elastic
     ... --spacings 0.002,0.001 --courants 1,0.5,0.25,0.125 --fem-spacings 0.001,0.0005,0.00025
 
-Each MPM run: platen down at 0.1 m/s to a strain of 1e-4, then held with local damping 0.5 until the platen force
-changes by less than 1e-5 of itself over one P-wave transit of the specimen. Modulus two ways: platen force / width
-over platen travel / height, and over the specimen's own strain (mean displacement of the top particle row against
-the bottom row). Outputs: OUT/summary.json, OUT/table.md."""
+Each MPM run: yade_mpm_paper.validation.filled_flaw.mpm_modulus. Outputs: OUT/summary.json (after every run),
+OUT/table.md."""
 import argparse
 import json
 import math
 import os
-import time
 
 import numpy as np
 
@@ -23,43 +20,7 @@ import yade_mpm as ym
 from yade_mpm import rocks
 from yade_mpm_paper import cases, uncertainty
 from yade_mpm_paper.validation import fem_flaw
-
-STRAIN = 1e-4
-RUNS = {"intact": ("intact", 0.0, 0.0), "open": ("open", 0.0, 0.0), "filled μ 0.6": ("filled", 0.6, 0.0), "filled, never slips": ("filled", 0.6, 1e9)}
-
-
-def mpm_modulus(name, spacing, courant):
-    from yade import O
-    from yade.minieigenHP import Vector3
-    variant, mu, c = RUNS[name]
-    m = rocks.MIAO2018_SANDSTONE
-    rock = ym.ElasticMat(young=m["young"], poisson=m["poisson"], density=m["density"])
-    s, sc = cases.uniaxial_flaw(variant, spacing, mu_con=mu, c_con=c, material=rock, label="mpm_elastic")
-    s.courant = courant
-    H, W = sc["height"], sc["width"]
-    y0 = ym.get(s, "pos")[:, 1]
-    top, bot = y0 > y0.max() - 1e-9, y0 < y0.min() + 1e-9
-    t0 = time.time()
-    while sc["axial_strain"]() < STRAIN:
-        O.step()
-    O.bodies[sc["platen"]].state.vel = Vector3(0, 0, 0)
-    s.damping = 0.5
-    c_p = math.sqrt(m["young"] * (1 - m["poisson"]) / ((1 + m["poisson"]) * (1 - 2 * m["poisson"]) * m["density"]))
-    transit, last, settled = H / c_p, None, False
-    while O.time < 0.01:
-        t_end = O.time + transit
-        while O.time < t_end:
-            O.step()
-        f = sc["axial_stress"]()
-        if last is not None and abs(f - last) < 1e-5 * abs(f):
-            settled = True
-            break
-        last = f
-    y = ym.get(s, "pos")[:, 1]
-    own = ((y0[top] - y[top]).mean() - (y0[bot] - y[bot]).mean()) / (y0[top].mean() - y0[bot].mean())
-    sig = sc["axial_stress"]()
-    return dict(run=name, spacing_m=spacing, courant=courant, platen_modulus_Pa=sig / sc["axial_strain"](),
-                own_modulus_Pa=sig / own, settled=settled, steps=int(s.steps), particles=int(s.numParticles), wall_s=time.time() - t0)
+from yade_mpm_paper.validation.filled_flaw import RUNS, mpm_modulus
 
 
 def main():
