@@ -21,15 +21,17 @@ import numpy as np
 import yade_mpm as ym
 from yade_mpm import checkpoint
 mode, ck, out = sys.argv[1], sys.argv[2], sys.argv[3]
-s = ym.make_solver((0.0, 0.0), (0.22, 0.36), 0.01, margin=2)          # 40 cells along y: 5 block layers
+spread = len(sys.argv) > 4 and sys.argv[4] == "distribute"          # each rank builds only its slab
+s = ym.make_solver((0.0, 0.0), (0.22, 0.36), 0.01, margin=2, distribute=spread)   # 40 cells along y: 5 block layers
 ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0.04), (0.2, 0.24))
 s.addBoundaryPlane(0, -1, 0.0, "slip")
 s.gravity, s.damping, s.sortPeriod = (0.0, -9.81), 0.02, 5
 x = s.view("x0"); v = s.view("v1"); v[:] = 20.0 + 3.0 * np.sin(np.pi * x / 0.2); del x, v   # drifts across the slab boundary
 s.requestSort()
 rank = ym.parallel.rank()
+built = s.numParticles                         # this rank's particles of the fresh scene
 if mode == "save":
-    s.run(20)                                  # the first particles cross y = 0.14 m after ~28 steps: after the save
+    s.run(32 if spread else 20)                # the first particles cross y = 0.14 m after ~28 steps: before / after the save
     checkpoint.save(ck, s)
 elif mode == "resume":
     checkpoint.load(ck, s)
@@ -41,14 +43,16 @@ else:                                          # another rank count: refused, no
         assert s.steps == 0
         sys.exit(0)
     raise AssertionError("loaded a checkpoint of another rank count")
+loaded = s.numParticles                        # resume: this rank's particles of its piece
 s.run(20)
 names = ["x0", "x1", "v0", "v1", "C0", "C1", "C2", "C3", "sig0", "sig1", "sig2", "sig3", "vol", "mass", "id"]
-np.savez(f"{out}.{rank}.npz", time=s.time, steps=s.steps, migrated=s.mpiInfo()["migrated"] if hasattr(s, "mpiInfo") else 0,
+np.savez(f"{out}.{rank}.npz", time=s.time, steps=s.steps, migrated=s.mpiInfo()["migrated"] if hasattr(s, "mpiInfo") else 0, built=built, loaded=loaded,
          **{n: np.array(s.view(n)) for n in names})
 """
 
 
 def _launch(tmp_path, ranks, *args, timeout=600):
+    """Runs CHILD with args (mode, checkpoint, out[, "distribute"]) on `ranks` ranks (1: one process)."""
     script = tmp_path / "ck_child.py"
     script.write_text(CHILD)
     env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "py"))
@@ -67,7 +71,7 @@ def test_checkpoint_resume_bitwise_and_rank_count(tmp_path):
     for k in range(2):
         a, b = dict(np.load(tmp_path / f"straight.{k}.npz")), dict(np.load(tmp_path / f"resumed.{k}.npz"))
         assert int(a["steps"]) == 40 and int(b["steps"]) == 40
-        differing = [n for n in a if n != "migrated" and a[n].tobytes() != b[n].tobytes()]
+        differing = [n for n in a if n not in ("migrated", "built", "loaded") and a[n].tobytes() != b[n].tobytes()]
         assert not differing, (k, differing)
     mig = lambda tag: sum(int(np.load(tmp_path / f"{tag}.{k}.npz")["migrated"]) for k in range(2))
     assert mig("resumed") > 20 and mig("resumed") == mig("straight"), (mig("straight"), mig("resumed"))   # migrations after the resume
@@ -75,3 +79,21 @@ def test_checkpoint_resume_bitwise_and_rank_count(tmp_path):
     assert out3.count("written by 2 MPI rank(s); this run has 3") == 3, out3
     out1 = _launch(tmp_path, 1, "other", ck, str(tmp_path / "one"))
     assert "written by 2 MPI rank(s); this run has 1" in out1, out1
+
+
+def test_checkpoint_of_a_distributed_build_resumes_bitwise(tmp_path):
+    """A scene built with make_solver(…, distribute=True) (no rank ever holds all particles) is saved on 2 ranks after
+    particles crossed the slab boundary and resumed into a fresh distributed build of it: each rank's arrays are
+    sized to its piece (its start slab held another count: one rank's arrays grow, the other's shrink), and 20 more
+    steps give the uninterrupted run's bits."""
+    ck = str(tmp_path / "dist.ckpt")
+    _launch(tmp_path, 2, "save", ck, str(tmp_path / "straight"), "distribute")
+    _launch(tmp_path, 2, "resume", ck, str(tmp_path / "resumed"), "distribute")
+    grew = []
+    for k in range(2):
+        a, b = dict(np.load(tmp_path / f"straight.{k}.npz")), dict(np.load(tmp_path / f"resumed.{k}.npz"))
+        assert int(a["steps"]) == 52 and int(b["steps"]) == 52 and len(a["id"]) > 100
+        differing = [n for n in a if n not in ("migrated", "built", "loaded") and a[n].tobytes() != b[n].tobytes()]
+        assert not differing, (k, differing)
+        grew.append(int(b["loaded"]) - int(b["built"]))
+    assert max(grew) > 0 > min(grew), grew

@@ -127,14 +127,17 @@ public:
 			throw InputError(std::string("MPI: ") + what + " after the first step is not supported on " + std::to_string(R)
 			                 + " ranks: each rank holds only its slab's particles now (doc/scaling.md)");
 	}
-	// Checkpoint resume (py/yade_mpm/checkpoint.py) into the freshly built, replicated scene: the saved slab
-	// layout, and the particle arrays cut to the rank's saved count n (the caller then writes the saved values).
-	void restore(Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n)
+	// Checkpoint resume (py/yade_mpm/checkpoint.py) into the freshly built scene: the saved slab layout, and the
+	// particle arrays sized to the rank's saved count n (the caller then writes the saved values). A replicated scene
+	// holds every particle (cut to n); a distributed one holds its start slab's (cut or grown to n, zero-filled), with
+	// the optional fields the piece has (opt: traction, damage state, flaw counts; ParticlePack::ensureFields).
+	void restore(Grid<D>& g, Particles<D>& P, const std::vector<int>& first, size_t n, const double* opt)
 	{
 		if (decomposed) throw InputError("MPI checkpoint resume: the solver has stepped already; load the checkpoint into the freshly built scene");
 		if (int(first.size()) != R + 1)
 			throw InputError("MPI checkpoint resume: the checkpoint's slab layout has " + std::to_string(int(first.size()) - 1) + " ranks, this run has " + std::to_string(R));
-		if (n > P.n) throw InputError("MPI checkpoint resume: " + std::to_string(n) + " particles saved on this rank, the scene has " + std::to_string(P.n));
+		if (n > P.n && !building)
+			throw InputError("MPI checkpoint resume: " + std::to_string(n) + " particles saved on this rank, the scene has " + std::to_string(P.n));
 		SlabLayout<D> L;
 		L.first = first;
 		for (int r = 0; r < R; ++r)
@@ -145,6 +148,12 @@ public:
 		std::vector<uint8_t> go(P.n, 0);
 		for (size_t p = n; p < P.n; ++p) go[p] = 1;
 		Pack::keep(P, go);
+		if (n > P.n) { // distributed construction: this rank's start slab held fewer than its saved piece
+			P.n = n;
+			P.forEachRealField([&](std::vector<Real>& f) { f.resize(n, 0.0); });
+			P.id.resize(n), P.mat.resize(n);
+		}
+		Pack::ensureFields(P, opt);
 		settle(g);
 	}
 	// Before the counting sort: the first call splits the (replicated) scene, later calls re-balance (when the

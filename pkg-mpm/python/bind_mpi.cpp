@@ -82,13 +82,14 @@ bp::list maxList(bp::object values)
 // Checkpoint resume (py/yade_mpm/checkpoint.py): the saved slab layout and the rank's particle count; the
 // particle arrays are cut to n (no NumPy view may be alive), then Python writes the saved values into them.
 template <int D>
-void mpiRestoreSlab(Solver<D>& s, bp::object first, long n)
+void mpiRestoreSlab(Solver<D>& s, bp::object first, long n, bool traction, bool damageState, bool flaws)
 {
 	if (s.liveViews) throw InputError("MPI checkpoint resume: delete the NumPy views of the particle arrays first");
 	if (n < 0) throw InputError("MPI checkpoint resume: particles = " + std::to_string(n) + " must be ≥ 0");
 	std::vector<int> f;
 	for (long k = 0; k < bp::len(first); ++k) f.push_back(bp::extract<int>(first[k]));
-	s.dd.restore(s.grid, s.P, f, size_t(n));
+	const double opt[3] = { double(traction), double(damageState), double(flaws) };
+	s.dd.restore(s.grid, s.P, f, size_t(n), opt);
 	s.requestSort();
 }
 
@@ -153,7 +154,8 @@ void exposeMpi(SolverClass<D>& cls, const char*)
 	cls.def("_mpiPlan", &mpiPlan<D>,
 	        "Distributed construction, before adding a region: its particle counts per block layer (the same on every rank); the first region sets the "
 	        "start layout and the grid window from them, every region reserves this rank's share.");
-	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, "Checkpoint resume: the saved slab layout and the rank's particle count (yade_mpm.checkpoint).");
+	cls.def("_mpiRestoreSlab", &mpiRestoreSlab<D>, (bp::arg("firstLayers"), bp::arg("particles"), bp::arg("traction") = false, bp::arg("damageState") = false, bp::arg("flaws") = false),
+	        "Checkpoint resume: the saved slab layout, the rank's particle count and the optional fields of its piece (yade_mpm.checkpoint).");
 }
 template void exposeMpi<2>(SolverClass<2>&, const char*);
 template void exposeMpi<3>(SolverClass<3>&, const char*);

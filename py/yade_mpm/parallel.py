@@ -65,8 +65,8 @@ def distribute(solver):
     with the ids 1 process would give; the first step re-cuts the slabs by the particle counts. Nothing happens
     on 1 process. The solver was created with the whole grid (freed here); make_solver(…, distribute=True)
     never allocates it on a rank. Builders that need every particle on every
-    rank refuse (add_region with thin gaps excluded, d0 = 'initial' bodies); a checkpoint resumes into the
-    replicated build only."""
+    rank refuse (add_region with thin gaps excluded, d0 = 'initial' bodies); a checkpoint resumes into the scene
+    built again with or without distribute (the same rank count)."""
     if size() > 1:
         solver._mpiDistribute()
     return solver

@@ -75,6 +75,9 @@ def solver_fingerprint(solver, ids=None):
 
 
 _REMOVED = ("id", "step", "time", "pos", "vel", "mass", "damage", "face", "material", "reason")
+# Fingerprint entries of the particles themselves: a distributed build's rank holds other particles than its piece
+# (checked there: the total over the ranks)
+_PER_PARTICLE = ("particles", "arrays", "mass_vol0", "loads", "material_index")
 
 
 def _solver_state(solver):
@@ -268,16 +271,23 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
         gone = int(header.get("removed", {}).get(n, 0))          # particles removed after leaving the grid
         # MPI: this rank's particles of the fresh scene; after removals: the particles still in the computation
         ids = arrays[f"solver/{n}/id"] if (mpi or gone) else None
-        if mpi and s.mpiInfo().get("distributedBuild"):
-            problems.append(f"solver {n} was built with yade_mpm.parallel.distribute (each rank holds only its slab): a checkpoint "
-                            "resumes into the replicated build; build the scene without distribute to resume")
+        spread = bool(mpi) and bool(s.mpiInfo().get("distributedBuild"))   # each rank built only its slab (distribute)
+        if spread:   # the scene's particles over every rank (a collective: every rank of a distributed build is here)
+            here = int(round(_core.mpiSum(float(s.numParticles))))
+            if mpi[n]["total"] + gone != here:
+                problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
+                                f"{here} in this scene")
         elif mpi and mpi[n]["total"] + gone != s.numParticles:
             problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
                             f"{s.numParticles} in this scene")
         if not mpi and gone and len(ids) + gone != s.numParticles:
             problems.append(f"solver {n}: {len(ids)} particles and {gone} removed in the checkpoint, {s.numParticles} in this scene")
         try:
-            problems += diff(header["solvers"][n], solver_fingerprint(s, ids), f"solver {n}: ")
+            if spread:   # the rank's slab holds other particles than its piece: the scene's grid, materials and contact
+                saved = {k: v for k, v in header["solvers"][n].items() if k not in _PER_PARTICLE}
+                problems += diff(saved, {k: v for k, v in solver_fingerprint(s).items() if k not in _PER_PARTICLE}, f"solver {n}: ")
+            else:
+                problems += diff(header["solvers"][n], solver_fingerprint(s, ids), f"solver {n}: ")
         except CheckpointError as e:
             problems.append(f"solver {n}: {e}")
         saved, here = sorted(header["settings"][n]), sorted(s.settings())
@@ -294,9 +304,13 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
         raise CheckpointError(f"checkpoint {path} is for another scene: " + "; ".join(problems[:8])
                               + (f" (+{len(problems) - 8} more)" if len(problems) > 8 else ""))
     for n, s in sol.items():                      # every check passed: now change the state
-        if mpi:                                   # the slab layout; the arrays cut to this rank's particles
-            s._mpiRestoreSlab(mpi[n]["firstLayers"], mpi[n]["particles"])
-        _restore_solver(s, {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")}, header["settings"][n])
+        mine = {k.split("/", 2)[2]: v for k, v in arrays.items() if k.startswith(f"solver/{n}/")}
+        if mpi:                                   # the slab layout; the arrays sized to this rank's particles
+            s._mpiRestoreSlab(mpi[n]["firstLayers"], mpi[n]["particles"], traction="trac0" in mine, damageState="damage" in mine,
+                              flaws="nFlaw" in mine)
+            if s.mpiInfo().get("distributedBuild"):   # an optional array the rank's piece has not (none of its
+                mine.update({k: np.zeros_like(v) for k, v in _particle_arrays(s).items() if k not in mine})   # particles had a traction): 0
+        _restore_solver(s, mine, header["settings"][n])
     if with_yade:
         d = os.path.dirname(os.path.abspath(path))
         tmp = os.path.join(d, f".yade-scene-{os.getpid()}.yade")
