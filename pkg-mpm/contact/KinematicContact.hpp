@@ -222,9 +222,8 @@ private:
 		const size_t mine = kc.size(), at = s.exchange.gatherInOrder(kc);
 		for (size_t j = 0; j < kc.size(); ++j) kc[j].mine = j >= at && j < at + mine;
 		s.exchange.agree(s.err, "contact");
-		std::sort(kc.begin(), kc.end(), [](const KinematicContactRec<D>& a, const KinematicContactRec<D>& b) {
-			return a.block != b.block ? a.block < b.block : a.id < b.id;
-		});
+		auto before = [](const KinematicContactRec<D>& a, const KinematicContactRec<D>& b) { return a.block != b.block ? a.block < b.block : a.id < b.id; };
+		if (!std::is_sorted(kc.begin(), kc.end(), before)) std::sort(kc.begin(), kc.end(), before); // collected in block order: often sorted
 		if (tabs.size() < groups.size()) tabs.resize(groups.size());
 		auto& t = tabs[gi];
 		t.node.clear();
