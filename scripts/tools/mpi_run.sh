@@ -22,4 +22,5 @@ export OMP_NUM_THREADS=$T
 export PYTHONPATH="$here/py${PYTHONPATH:+:$PYTHONPATH}"
 pass=(-x OMP_NUM_THREADS -x PYTHONPATH)
 [ -n "${YADE_MPM_MPI:-}" ] && pass+=(-x YADE_MPM_MPI)
+[ -n "${YADE_MPM_BUILD_DIR:-}" ] && pass+=(-x YADE_MPM_BUILD_DIR)   # another build folder (py/yade_mpm/_build.py), on every host
 exec mpirun -np "$N" --oversubscribe --bind-to none "${pass[@]}" /usr/bin/python3 "$@"
