@@ -39,12 +39,16 @@ public:
 		if (!hasKinematic()) return;
 		s.exchange.oneThread([&] {
 			const bool dist = s.exchange.distributed(); // the reactions' changes are summed over the processes like apply's
-			if (dist) kept.assign(parts.begin(), parts.end());
-			if (dist) for (auto& q : parts) q.force.setZero(), q.torque.setZero();
+			if (dist) {
+				kept.assign(parts.begin(), parts.end());
+				for (auto& q : parts) q.force.setZero(), q.torque.setZero();
+			}
 			for (size_t gi = 0; gi < groups.size(); ++gi)
 				if (groups[gi].params.law == ContactLaw::Kinematic && !work[gi].skip) this->reprojectKinematic(gi, s);
-			if (dist) sumReactions(s.exchange);
-			if (dist) for (size_t p = 0; p < parts.size(); ++p) parts[p].force += kept[p].force, parts[p].torque += kept[p].torque;
+			if (dist) {
+				sumReactions(s.exchange);
+				for (size_t p = 0; p < parts.size(); ++p) parts[p].force += kept[p].force, parts[p].torque += kept[p].torque;
+			}
 		});
 	}
 

@@ -145,10 +145,11 @@ public:
 				throw InputError("MPI checkpoint resume: the saved slab layout does not fit this grid");
 		L.checkMirrors(g);
 		layout = L;
-		std::vector<uint8_t> go(P.n, 0);
-		for (size_t p = n; p < P.n; ++p) go[p] = 1;
-		Pack::keep(P, go);
-		if (n > P.n) { // distributed construction: this rank's start slab held fewer than its saved piece
+		if (n < P.n) {
+			std::vector<uint8_t> go(P.n, 0);
+			for (size_t p = n; p < P.n; ++p) go[p] = 1;
+			Pack::keep(P, go);
+		} else if (n > P.n) { // distributed construction: this rank's start slab held fewer than its saved piece
 			P.n = n;
 			P.forEachRealField([&](std::vector<Real>& f) { f.resize(n, 0.0); });
 			P.id.resize(n), P.mat.resize(n);

@@ -60,8 +60,7 @@ private:
 				for (double *f = s[k].data + i0 * s[k].per, *e = s[k].data + i1 * s[k].per; f < e; ++f) *f += buf[j++];
 		};
 		add(rd, d0, d1), add(ru, u0, u1);
-		if (!Comm::all(err.none()) && err.none())
-			err.record(ErrorRecord::elsewhere, std::string("stopped: the ") + phase + " of another MPI rank failed (its message names the particle)");
+		Comm::agree(err, phase);
 	}
 };
 

@@ -49,21 +49,30 @@ struct Comm {
 	}
 	// The concatenation of every rank's bytes in rank order, on every rank (an all-gather of the counts, then of the
 	// bytes); returns where this rank's bytes start in `all`.
-	static size_t gatherBytes(const char* mine, size_t n, std::vector<char>& all)
+	// counts: scratch (2 ints per rank).
+	static size_t gatherBytes(const char* mine, size_t n, std::vector<char>& all, std::vector<int>& counts)
 	{
-		const int         R = size(), me = rank();
-		std::vector<int>  count(size_t(R), 0), at(size_t(R), 0);
+		const int R = size(), me = rank();
+		counts.assign(2 * size_t(R), 0);
+		int* const count = counts.data();
+		int* const at    = count + R;
 		if (n > size_t(INT32_MAX)) throw SimulationError("MPI gather of " + std::to_string(n) + " bytes exceeds the 2^31 − 1 limit of one message");
 		const int nn = int(n);
-		MPI_Allgather(&nn, 1, MPI_INT, count.data(), 1, MPI_INT, world());
+		MPI_Allgather(&nn, 1, MPI_INT, count, 1, MPI_INT, world());
 		size_t total = 0;
 		for (int r = 0; r < R; ++r) {
 			if (total > size_t(INT32_MAX)) throw SimulationError("MPI gather exceeds the 2^31 − 1 byte limit of one message");
-			at[size_t(r)] = int(total), total += size_t(count[size_t(r)]);
+			at[r] = int(total), total += size_t(count[r]);
 		}
 		all.resize(total);
-		MPI_Allgatherv(mine, nn, MPI_BYTE, all.data(), count.data(), at.data(), MPI_BYTE, world());
-		return size_t(at[size_t(me)]);
+		MPI_Allgatherv(mine, nn, MPI_BYTE, all.data(), count, at, MPI_BYTE, world());
+		return size_t(at[me]);
+	}
+	// A failure recorded on any rank reaches every rank's err (the other ranks' as "elsewhere"); phase names the step's part.
+	static void agree(ErrorRecord& err, const char* phase)
+	{
+		if (!all(err.none()) && err.none())
+			err.record(ErrorRecord::elsewhere, std::string("stopped: the ") + phase + " of another MPI rank failed (its message names the particle)");
 	}
 	// True on every rank iff `ok` is true on every rank (a failure on one rank stops all of them together).
 	static bool all(bool ok)

@@ -32,17 +32,16 @@ struct MpiExchange {
 	size_t gatherInOrder(std::vector<T>& v) const
 	{
 		if (!distributed()) return 0;
-		std::vector<char> all;
-		const size_t      at = Comm::gatherBytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T), all);
-		v.resize(all.size() / sizeof(T));
-		std::memcpy(static_cast<void*>(v.data()), all.data(), all.size());
+		const size_t at = Comm::gatherBytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T), gathered, counts);
+		v.resize(gathered.size() / sizeof(T));
+		std::memcpy(static_cast<void*>(v.data()), gathered.data(), gathered.size());
 		return at / sizeof(T);
 	}
 	void agree(ErrorRecord& err, const char* phase) const
 	{
-		if (distributed() && !Comm::all(err.none()) && err.none())
-			err.record(ErrorRecord::elsewhere, std::string("stopped: the ") + phase + " of another MPI rank failed (its message names the particle)");
+		if (distributed()) Comm::agree(err, phase);
 	}
+
 	// MPI is called by the master thread only (MPI_THREAD_FUNNELED), hence master and a barrier, not `single`.
 	template <class F>
 	static void oneThread(F&& f)
@@ -51,6 +50,10 @@ struct MpiExchange {
 		f();
 #pragma omp barrier
 	}
+
+private:
+	mutable std::vector<char> gathered; // scratch of gatherInOrder (capacity kept between steps)
+	mutable std::vector<int>  counts;
 };
 
 } // namespace mpm

@@ -80,7 +80,8 @@ bp::list maxList(bp::object values)
 }
 
 // Checkpoint resume (py/yade_mpm/checkpoint.py): the saved slab layout and the rank's particle count; the
-// particle arrays are cut to n (no NumPy view may be alive), then Python writes the saved values into them.
+// particle arrays are sized to n (cut, or grown in a distributed build; no NumPy view may be alive) with the
+// piece's optional fields, then Python writes the saved values into them.
 template <int D>
 void mpiRestoreSlab(Solver<D>& s, bp::object first, long n, bool traction, bool damageState, bool flaws)
 {
