@@ -17,10 +17,8 @@ import os
 import numpy as np
 
 import yade_mpm as ym
-from yade_mpm import rocks
-from yade_mpm_paper import cases, uncertainty
-from yade_mpm_paper.validation import fem_flaw
-from yade_mpm_paper.validation.filled_flaw import RUNS, mpm_modulus
+from yade_mpm_paper import uncertainty
+from yade_mpm_paper.validation.filled_flaw import RUNS, fem_modulus, mpm_modulus, plane_strain_modulus
 
 
 def main():
@@ -40,13 +38,10 @@ def main():
     courants = [ym.scene.check_courant(float(x)) for x in a.courants.split(",")]
     fem_h = [float(x) for x in a.fem_spacings.split(",")]
     os.makedirs(a.out, exist_ok=True)
-    m = rocks.MIAO2018_SANDSTONE
-    plane = m["young"] / (1 - m["poisson"] ** 2)
-    g = cases.uniaxial_flaw_geometry()
+    plane = plane_strain_modulus()
     fem = {}
     for kind in ("open", "bonded"):
-        vals = [fem_flaw.apparent_modulus(kind, cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT, g["polygon"], m["young"], m["poisson"], h)[0]
-                for h in fem_h]
+        vals = [fem_modulus(kind, h) for h in fem_h]
         rich = uncertainty.richardson(fem_h, vals) if len(vals) >= 3 else dict(limit=None, order=None)
         fem[kind] = dict(spacings_m=fem_h, modulus_Pa=vals, limit_Pa=rich["limit"] or vals[-1], order=rich["order"])
         print(f"[fem] {kind}: " + ", ".join(f"{v / plane:.5f}" for v in vals) + f" × E/(1−ν²); limit {fem[kind]['limit_Pa'] / plane:.5f}", flush=True)

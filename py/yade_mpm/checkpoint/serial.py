@@ -80,6 +80,11 @@ _REMOVED = ("id", "step", "time", "pos", "vel", "mass", "damage", "face", "mater
 _PER_PARTICLE = ("particles", "arrays", "mass_vol0", "loads", "material_index")
 
 
+def _scene_only(fingerprint):
+    """A solver fingerprint without its per-particle entries."""
+    return {k: v for k, v in fingerprint.items() if k not in _PER_PARTICLE}
+
+
 def _solver_state(solver):
     arrs = {k: np.array(v, copy=True) for k, v in _particle_arrays(solver).items()}
     for k, v in solver._removedParticles().items():   # particles removed after leaving the grid (this rank's)
@@ -266,26 +271,22 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
             raise CheckpointError(f"checkpoint {path} holds solvers {sorted(names)}, given {sorted(sol)}")
     else:
         raise ValueError("solvers must be None, a Solver2D/3D or a {name: solver} dict")
-    problems = []
+    problems, spread = [], {}
     for n, s in sol.items():
         gone = int(header.get("removed", {}).get(n, 0))          # particles removed after leaving the grid
         # MPI: this rank's particles of the fresh scene; after removals: the particles still in the computation
         ids = arrays[f"solver/{n}/id"] if (mpi or gone) else None
-        spread = bool(mpi) and bool(s.mpiInfo().get("distributedBuild"))   # each rank built only its slab (distribute)
-        if spread:   # the scene's particles over every rank (a collective: every rank of a distributed build is here)
-            here = int(round(_core.mpiSum(float(s.numParticles))))
-            if mpi[n]["total"] + gone != here:
-                problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
-                                f"{here} in this scene")
-        elif mpi and mpi[n]["total"] + gone != s.numParticles:
+        spread[n] = bool(mpi) and bool(s.mpiInfo().get("distributedBuild"))   # each rank built only its slab (distribute)
+        # the scene's particles: every rank's of a distributed build (a collective: all its ranks are here), else this rank's
+        here = int(round(_core.mpiSum(float(s.numParticles)))) if spread[n] else s.numParticles
+        if mpi and mpi[n]["total"] + gone != here:
             problems.append(f"solver {n}: {mpi[n]['total']} particles over the ranks and {gone} removed in the checkpoint, "
-                            f"{s.numParticles} in this scene")
+                            f"{here} in this scene")
         if not mpi and gone and len(ids) + gone != s.numParticles:
             problems.append(f"solver {n}: {len(ids)} particles and {gone} removed in the checkpoint, {s.numParticles} in this scene")
         try:
-            if spread:   # the rank's slab holds other particles than its piece: the scene's grid, materials and contact
-                saved = {k: v for k, v in header["solvers"][n].items() if k not in _PER_PARTICLE}
-                problems += diff(saved, {k: v for k, v in solver_fingerprint(s).items() if k not in _PER_PARTICLE}, f"solver {n}: ")
+            if spread[n]:   # the rank's slab holds other particles than its piece: the scene's grid, materials and contact
+                problems += diff(_scene_only(header["solvers"][n]), _scene_only(solver_fingerprint(s)), f"solver {n}: ")
             else:
                 problems += diff(header["solvers"][n], solver_fingerprint(s, ids), f"solver {n}: ")
         except CheckpointError as e:
@@ -308,7 +309,7 @@ def _load(path, header, arrays, solvers, yade, meta, mpi=None):
         if mpi:                                   # the slab layout; the arrays sized to this rank's particles
             s._mpiRestoreSlab(mpi[n]["firstLayers"], mpi[n]["particles"], traction="trac0" in mine, damageState="damage" in mine,
                               flaws="nFlaw" in mine)
-            if s.mpiInfo().get("distributedBuild"):   # an optional array the rank's piece has not (none of its
+            if spread[n]:                             # an optional array the rank's piece has not (none of its
                 mine.update({k: np.zeros_like(v) for k, v in _particle_arrays(s).items() if k not in mine})   # particles had a traction): 0
         _restore_solver(s, mine, header["settings"][n])
     if with_yade:

@@ -10,6 +10,7 @@ import yade_mpm as ym
 from yade_mpm import rocks
 
 from .. import cases
+from . import fem_flaw
 
 STRAIN = 1e-4  # platen strain of the test [-]
 # run: (flaw variant, μ_con [-], c_con [Pa]); c_con = 1e9 Pa: the filler never slips
@@ -21,6 +22,14 @@ def plane_strain_modulus():
     """E/(1 − ν²) of the Miao 2018 sandstone [Pa]."""
     m = rocks.MIAO2018_SANDSTONE
     return m["young"] / (1 - m["poisson"] ** 2)
+
+
+def fem_modulus(kind, h):
+    """Apparent modulus of the same specimen by the plane-strain FEM (``fem_flaw``): kind 'open', 'bonded' or
+    'intact', mesh size h [m] [Pa]."""
+    m = rocks.MIAO2018_SANDSTONE
+    return fem_flaw.apparent_modulus(kind, cases.UNIAXIAL_WIDTH, cases.UNIAXIAL_HEIGHT, cases.uniaxial_flaw_geometry()["polygon"],
+                                     m["young"], m["poisson"], h)[0]
 
 
 def mpm_modulus(name, spacing, courant):
