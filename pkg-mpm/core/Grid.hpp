@@ -43,7 +43,7 @@ struct Grid {
 	size_t stride[3];  // linear index strides
 	std::vector<Node<D>>    nodes; // P2G: m, mw, momentum, force (GridNode.hpp)
 	std::vector<NodeVec<D>> vel;   // gridUpdate (+ contact): updated velocity, Eq. 18
-	std::vector<NodeVec<D>> vold;  // gridUpdate keepOld: velocity before the step, for dampAfterContact
+	std::vector<NodeVec<D>> vold;  // gridUpdate keepOld: velocity before the step, for dampAfterContact and FLIP (Transfer::g2p)
 	std::vector<NodeVec<D>> mom;   // G2P: MUSL momentum Σ w m h_p(x_i), Eq. 16 numerator
 	std::vector<NodeVec<D>> vmusl; // gridMusl: MUSL velocity, Eqs. 16–17
 	std::vector<uint8_t> fixMask;     // bit a set: velocity component a is prescribed zero

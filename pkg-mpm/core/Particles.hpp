@@ -165,11 +165,12 @@ struct Particles {
 	}
 	// Work of gravity g and the surface forces (× loadScale) on the particles over dt, Σ (m g + s f)·v dt [J].
 	template <class Vec>
-	Real externalWork(const Vec& g, Real loadScale, Real dt) const
+	// Work of gravity and tractions over a step in which particle p moved by Δt u[a][p] (u: v, or FLIP's vg).
+	Real externalWork(const Vec& g, Real loadScale, Real dt, const std::vector<Real> (&u)[D]) const
 	{
 		Real w = 0;
 		for (size_t p = 0; p < n; ++p)
-			for (int a = 0; a < D; ++a) w += (mass[p] * g[a] + (hasTraction() ? loadScale * trac[a][p] : 0.0)) * v[a][p] * dt;
+			for (int a = 0; a < D; ++a) w += (mass[p] * g[a] + (hasTraction() ? loadScale * trac[a][p] : 0.0)) * u[a][p] * dt;
 		return w;
 	}
 

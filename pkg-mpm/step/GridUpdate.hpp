@@ -11,7 +11,7 @@ inline Real cundallDamped(Real f, Real v, Real alpha) { return alpha > 0 && v !=
 // Nodal momentum balance with lumped mass (Eq. 18): v_i ← p_i/m_i + Δt f_i/m_i, with Cundall local
 // damping f ← f − α|f|sign(v) and the boundary planes (fixMask). Nodes lighter than massFloor carry no
 // velocity. Reads nodes (m, p, f; without damping p holds p + Δt f and f = 0: GridNode.hpp); writes vel; clears mom
-// (G2P collects the MUSL momentum next). keepOld: vold ← the velocity before the step (p_i/m_i), for dampAfterContact.
+// (G2P collects the MUSL momentum next). keepOld: vold ← the velocity before the step (p_i/m_i), for dampAfterContact and FLIP.
 template <int D>
 inline void gridUpdate(Grid<D>& grid, Real dt, Real damping, Real massFloor, bool keepOld = false)
 {

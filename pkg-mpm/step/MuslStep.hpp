@@ -32,6 +32,7 @@ struct StepInputs {
 	Real                 dt, loadScale, damping, massFloor; // [s], traction ramp factor [-], Cundall α [-], [kg]
 	typename Dim<D>::Vec gravity;                           // [m/s²]
 	bool                 withContact, mirrors, viewWrites;  // rigid bodies, symmetry planes, state written through views
+	bool                 flip;                              // velocityUpdate 'flip': G2P needs the velocities before the step
 };
 
 // Wall clock of the phase ends (master thread), for Solver::phase.
@@ -54,13 +55,13 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 	Grid<D>& grid = xfer.grid;
 #pragma omp parallel
 	{
-		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, in.dt, in.damping == 0, errP2G); // 1: Eqs. 20–22 (no damping: p + Δt f fused)
+		xfer.p2g(mat, in.gravity, in.loadScale, in.viewWrites, in.dt, in.damping == 0 && !in.flip, errP2G); // 1: Eqs. 20–22 (no damping, PIC: p + Δt f fused)
 		ex.sumShared(grid, grid.nodes, errP2G, "P2G");                   // + the other processes' partial sums
 		if (in.mirrors) grid.mirrors.fold(grid.nodes);                   // symmetry planes: add the reflected images
 		stampTime(t[1]);
 		if (errP2G.none()) {
 			const bool dampLate = in.withContact && in.damping > 0; // damp the net force, contact included
-			gridUpdate(grid, in.dt, dampLate ? 0 : in.damping, in.massFloor, dampLate); // 2: Eq. 18
+			gridUpdate(grid, in.dt, dampLate ? 0 : in.damping, in.massFloor, dampLate || in.flip); // 2: Eq. 18
 			stampTime(t[2]);
 			if (in.withContact) {
 				contact.apply(cs); // 3: Eqs. 23–26
@@ -70,10 +71,13 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 					contact.reproject(cs); // kinematic law: the damped velocities meet the constraints again
 				}
 			}
-			if (in.mirrors) grid.mirrors.unfold(grid.nodes), grid.mirrors.unfold(grid.vel); // nodes beyond a symmetry plane take their partner's reflection
+			if (in.mirrors) { // nodes beyond a symmetry plane take their partner's reflection
+				grid.mirrors.unfold(grid.nodes), grid.mirrors.unfold(grid.vel);
+				if (in.flip) grid.mirrors.unfold(grid.vold);
+			}
 			stampTime(t[3]);
 			if (errContact.none()) {
-				xfer.g2p(errG2P); // 4: Eqs. 6–7, MUSL momentum (Eq. 16)
+				xfer.g2p(errG2P, in.flip); // 4: Eqs. 6–7 (or FLIP), MUSL momentum (Eq. 16)
 				ex.sumShared(grid, grid.mom, errG2P, "G2P"); // + the other processes' partial sums
 				if (errG2P.none()) {
 					if (in.mirrors) grid.mirrors.fold(grid.mom);
@@ -89,10 +93,10 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 // Phases 6–7 in one parallel loop over blocks: a block's particles move right after its stress update,
 // while they are in cache. Failures are recorded in errStress, errMove; the caller throws.
 template <int D, class Mat>
-inline ParticleStepStats particlePhases(const Transfer<D>& xfer, const Mat& mat, Real dt, ErrorRecord& errStress, ErrorRecord& errMove)
+inline ParticleStepStats particlePhases(const Transfer<D>& xfer, const Mat& mat, Real dt, bool flip, ErrorRecord& errStress, ErrorRecord& errMove)
 {
 	return updateStress(xfer, mat, dt, errStress, [&](uint32_t b, Real& v2max, int& drift) { // 6: Eqs. 7, 27–40
-		moveParticles(xfer, dt, b, v2max, drift, errMove);                                  // 7
+		moveParticles(xfer, dt, b, flip, v2max, drift, errMove);                            // 7
 	});
 }
 

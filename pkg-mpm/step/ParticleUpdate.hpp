@@ -120,25 +120,25 @@ inline std::string leftGridMessage(const Particles<D>& P, const Grid<D>& grid, s
 	       + ") m (grid spans [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m along axis " + std::to_string(a) + ")";
 }
 
-// x ← x + Δt v (the G2P velocity) for the particles of block b. Checks that each stays finite and on the
+// x ← x + Δt v (the G2P velocity; flip: Σ ψ_i v_i, Transfer::vg) for the particles of block b. Raises v2max by ‖v_p‖². Checks that each stays finite and on the
 // grid cut by the boundary planes (else err; a particle past the grid's edge goes to err.left, for the
 // solver's outside policy) and within the cells its block may reach before a re-sort
 // (BlockSchedule::reach): drift is set when one left them, so the deterministic colouring stays valid.
 // Raises v2max to the largest ‖v‖² (for Δt). A branch-free loop over the arrays; the messages are built
 // only when a particle failed.
 template <int D>
-inline void moveParticles(const Transfer<D>& tr, Real dt, uint32_t b, Real& v2max, int& drift, ErrorRecord& err)
+inline void moveParticles(const Transfer<D>& tr, Real dt, uint32_t b, bool flip, Real& v2max, int& drift, ErrorRecord& err)
 {
 	Particles<D>&  P    = tr.P;
 	const Grid<D>& grid = tr.grid;
 	const uint32_t p0 = tr.sched.start[b], p1 = tr.sched.start[b + 1];
 	Real           lo[D], alo[D], ahi[D], cellLo[D], cellHi[D];
 	Real*          x[D];
-	const Real*    v[D];
+	const Real *   u[D], *v[D]; // the velocity of the motion, the particle's velocity (the same array under PIC)
 	tr.sched.reach(b, cellLo, cellHi); // cells a particle of block b may reach before a re-sort
 	for (int a = 0; a < D; ++a) {
 		lo[a] = grid.origin[a], alo[a] = grid.allowedLo[a], ahi[a] = grid.allowedHi[a]; // the grid cut by the boundary planes
-		x[a] = P.x[a].data(), v[a] = P.v[a].data();
+		x[a] = P.x[a].data(), v[a] = P.v[a].data(), u[a] = flip ? tr.vg[a].data() : v[a];
 	}
 	const Real invH = 1.0 / grid.spacing;
 	Real       vm = v2max;
@@ -147,9 +147,9 @@ inline void moveParticles(const Transfer<D>& tr, Real dt, uint32_t b, Real& v2ma
 		Real sp = 0, check = 0;
 		int  out = 0, nf = 0;
 		for (int a = 0; a < D; ++a) {
-			const Real va = v[a][p], xa = x[a][p] + dt * va;
+			const Real va = v[a][p], xa = x[a][p] + dt * u[a][p];
 			x[a][p] = xa;
-			sp += va * va;
+			sp += va * va; // Δt's max ‖v‖ from v_p, the state a resumed run starts from
 			check += xa;
 			out |= !(xa >= alo[a] && xa < ahi[a]);
 			const Real f = (xa - lo[a]) * invH;

@@ -172,7 +172,9 @@ public:
 		errP2G.clear(), errContact.clear(), errG2P.clear();
 		const ContactStep<D, StepExchange<D>> cs { grid, P, sched, xfer.offs, dt, massFloor, errContact, exchange };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
-			                     liveViews > 0 || viewTaken }; // viewWrites: P2G checks what views may have changed
+			                     liveViews > 0 || viewTaken, velocityUpdate == VelocityUpdate::Flip }; // viewWrites: P2G checks what views may have changed
+		if (in.flip)
+			for (auto& c : xfer.vg) c.resize(P.n); // grows only with the particle count
 		if (in.withContact) contact.beforeTransfer(cs);
 		double t[6] = { omp_get_wtime() };
 		materials.dispatch([&](const auto& mat) {
@@ -181,7 +183,7 @@ public:
 			viewTaken = false;                                                       // P2G accepted the state
 			throwIf(errG2P, "G2P", true);
 			ErrorRecord errStress, errMove;
-			auto        st = particlePhases(xfer, mat, dt, errStress, errMove); // phases 6–7
+			auto        st = particlePhases(xfer, mat, dt, in.flip, errStress, errMove); // phases 6–7
 			MPM_IF_MPI(dd.reduceStep(st.dtDensityMin, st.v2max, st.drift, errStress, errMove);) // global Δt limits, re-sort flag
 			throwIf(errStress, "stress update", true), throwIf(errMove, "position update", true);
 			if (errMove.leftAnywhere) settleLeaving(errMove, dt); // a particle left the grid (on some rank): outside policy
@@ -378,7 +380,7 @@ private:
 
 	void accumulateExternalWork(Real dt)
 	{
-		Real w = P.externalWork(gravity, loadScale(time + dt), dt);
+		Real w = P.externalWork(gravity, loadScale(time + dt), dt, velocityUpdate == VelocityUpdate::Flip ? xfer.vg : P.v); // the motion's velocity
 		MPM_IF_MPI(w = dd.sum(w);) // MPI: the work on every rank's particles
 		externalWork += w;
 	}

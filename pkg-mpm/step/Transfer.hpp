@@ -163,7 +163,18 @@ public:
 	// ------------------------------------------------------------ G2P + MUSL remap: Eqs. 6–7, 16–17
 	// Particle velocity and its WLS gradient from the updated nodal velocities (vel), then the particle's
 	// local linear velocity field is spread back with Shepard weights ξ = w m / Σ w m (into mom).
-	void g2p(ErrorRecord& err)
+	// flip (Solver.velocityUpdate): v_p ← v_p + Σ ψ_i (v_i − vold_i) instead of Eq. 6, and vg ← Σ ψ_i v_i, the
+	// velocity the particle moves with (moveParticles). The MUSL remap spreads Σ ψ_i v_i either way, so the strain
+	// (from the remap) and the motion come from one field, the one the contact and the boundary planes constrained.
+	void g2p(ErrorRecord& err, bool flip)
+	{
+		if (flip) g2pPass<true>(err);
+		else g2pPass<false>(err);
+	}
+	mutable std::vector<Real> vg[D]; // flip only: Σ ψ_i v_i of the last G2P, the velocity of the position update [m/s]
+
+	template <bool flip>
+	void g2pPass(ErrorRecord& err)
 	{
 		const KernelGeom<D> geo(grid);
 		scatterBlocks([&](uint32_t blk) {
@@ -175,13 +186,17 @@ public:
 				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
 				computeKernel<D, false>(g, x, k);
 				if (k.general) {
-					g2pCut(p, k, err);
+					g2pCut<flip>(p, k, err);
 					continue;
 				}
 				const Real m = P.mass[p];
 				Real       v[D], C[D][D];
 				gatherPacked(grid, grid.vel, k, g.gradFactor, v, C); // Eqs. 6–7 from the updated velocities
-				storeVelocity(p, v, C);
+				if constexpr (flip) {
+					Real vo[D], Co[D][D];
+					gatherPacked(grid, grid.vold, k, g.gradFactor, vo, Co); // the same fit of the velocities before the step
+					flipVelocity(p, v, vo, C);
+				} else storeVelocity(p, v, C);
 				Real mvv[D], mc[D][D]; // m h_p(x_i) = m (v + ∇v (x_i − x_p))
 				for (int a = 0; a < D; ++a) {
 					mvv[a] = m * v[a];
@@ -271,6 +286,7 @@ private:
 	// G2P of a particle with a cut stencil: v_p = Σ η_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum
 	// conserved; exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 	// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
+	template <bool flip>
 	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, ErrorRecord& err)
 	{
 		Stencil<D> st;
@@ -283,7 +299,13 @@ private:
 				for (int b = 0; b < D; ++b) C[a][b] += nd.c[a] * st.grad[n][b]; // Eq. 7
 			}
 		});
-		storeVelocity(p, v, C);
+		if constexpr (flip) {
+			Real vo[D] = {};
+			forStencil(grid.vold.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
+				for (int a = 0; a < D; ++a) vo[a] += st.eta[n] * nd.c[a];
+			});
+			flipVelocity(p, v, vo, C);
+		} else storeVelocity(p, v, C);
 		forStencil(grid.mom.data(), offs, st, [&](NodeVec<D>& nd, int n, const Real(&dx)[D]) {
 			const Real wm = st.w[n] * m;
 			for (int a = 0; a < D; ++a) {
@@ -292,6 +314,13 @@ private:
 				nd.c[a] += wm * h; // Eq. 16 numerator, h_p(x_i) = v_p + ∇v_p (x_i − x̄_p)
 			}
 		});
+	}
+	// FLIP: vg ← v (= Σ ψ_i v_i, the motion), v_p ← v_p + v − vo (the particle keeps what the grid cannot represent).
+	void flipVelocity(size_t p, const Real (&v)[D], const Real (&vo)[D], const Real (&C)[D][D])
+	{
+		Real vf[D];
+		for (int a = 0; a < D; ++a) vg[a][p] = v[a], vf[a] = P.v[a][p] + (v[a] - vo[a]);
+		storeVelocity(p, vf, C);
 	}
 	// The stress-pass gather of a cut stencil (velocityGradient).
 	[[gnu::noinline]] bool velocityGradientCut(size_t p, const Kernel<D>& k, Real (&L)[D][D], Real (&dbar)[D]) const

@@ -56,10 +56,24 @@ def setting_default(name):
 
 
 def courant_option(ap):
-    """Adds --courant to a script's argparse parser: default None = the solver's declared C (read, not
-    repeated); a value is checked against the declared range by :func:`check_courant`."""
+    """Adds --courant and --velocity-update to a script's argparse parser: default None = the solver's declared
+    value (read, not repeated); a C is checked against the declared range by :func:`check_courant`; both are
+    set on a solver by :func:`apply_step_options`."""
     ap.add_argument("--courant", type=float, default=None,
                     help=f"Courant number C of the step Δt = C·l/(v_c + max|v|) (default: the solver's, {setting_default('courant'):g})")
+    ap.add_argument("--velocity-update", choices=("flip", "pic"), default=None,
+                    help=f"particle velocity update in G2P: 'flip' or 'pic' (Eq. 6 as printed, the paper's) (default: the "
+                         f"solver's, {setting_default('velocityUpdate')})")
+
+
+def apply_step_options(solver, args):
+    """Sets the step options of :func:`courant_option` (args.courant, args.velocity_update; None = the solver's) on
+    `solver`; returns them as a dict for a run's record."""
+    if args.courant is not None:
+        solver.courant = args.courant
+    if getattr(args, "velocity_update", None) is not None:
+        solver.velocityUpdate = args.velocity_update
+    return dict(courant=solver.courant, velocity_update=solver.velocityUpdate)
 
 
 def check_courant(value, option="--courant"):

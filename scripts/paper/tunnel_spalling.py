@@ -97,7 +97,7 @@ class CaseRun:
         self.solver, self.bodies = cases.arch_tunnel(case, args.spacing, filler_friction=args.filler_mu, flaw_angle=math.radians(args.flaw_angle),
                                                      grout=rocks.cement_grout(young=args.grout_young), grid_shift=args.grid_shift)
         s = self.solver
-        s.courant = args.courant
+        step_options = ym.scene.apply_step_options(s, args)
         self.flaw = self.bodies["flaw"]
         self.dp = s.spacing / 2                                # ppc = 2
         self.x0 = ym.get(s, "pos")                             # initial positions by id
@@ -105,7 +105,7 @@ class CaseRun:
         self.rock = ym.get(s, "material") == 0                 # rock, not grout (material 0 of the scene)
         self.job = resumable.ResumableRun(s, self.dir, state=dict(first_crack=None, snapshots=[]), every_steps=args.ck_steps,
                                           every_minutes=args.ck_minutes, engine=self.bodies["engine"],
-                                          meta={"case": case, "spacing": args.spacing, "courant": args.courant, "flaw_angle": args.flaw_angle,
+                                          meta={"case": case, "spacing": args.spacing, **step_options, "flaw_angle": args.flaw_angle,
                                                 "filler_mu": args.filler_mu, "grout_young": args.grout_young,
                                                 "grid_shift": args.grid_shift})
         self.failed, self.interrupted = None, False

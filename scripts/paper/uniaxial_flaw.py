@@ -97,7 +97,7 @@ def one_run(variant, mu, c_mpa, a):
     os.makedirs(d, exist_ok=True)
     s, sc = cases.uniaxial_flaw(variant, a.spacing, mu_con=mu, c_con=c_mpa * 1e6, label="mpm_" + name.replace(".", "_"),
                                 filler_blocked=a.filler_blocked_dofs, grid_shift=a.grid_shift)
-    s.courant = a.courant
+    step_options = ym.scene.apply_step_options(s, a)
     snaps = {}
     snapshot = results.field_snapshots(snaps, ("pos", "damage", "plastic_strain", "max_principal_stress"))
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))   # ppc = 2, for the crack analytics
@@ -116,7 +116,7 @@ def one_run(variant, mu, c_mpa, a):
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=r["result"].reason,
                  error=getattr(r["result"], "error", None), time_reached_s=float(t[-1]),
-                 softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, courant=a.courant, grid_shift=a.grid_shift,
+                 softened=bool(r["result"].reason == "stop"), spacing_m=a.spacing, **step_options, grid_shift=a.grid_shift,
                  filler_motion=results.filler_motion(O.bodies[sc["filler"]]) if sc["filler"] is not None else None,
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],

@@ -111,6 +111,8 @@ def _restore_solver(solver, arrs, settings):
         if views[k].shape != arrs[k].shape:
             raise CheckpointError(f"particle array {k}: shape {arrs[k].shape} in the checkpoint, {views[k].shape} here")
     old = solver.settings()
+    settings = dict(settings)
+    settings.setdefault("velocityUpdate", "pic")  # saved before the setting existed: those runs used Eq. 6
     try:
         solver.setSettings(settings)              # all or nothing, each value checked against its range
         solver._setResumeState(sc)                 # checks the block schedule before changing anything
