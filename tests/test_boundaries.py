@@ -171,6 +171,7 @@ def test_faces_of_a_thin_crack_move_independently_and_closing_does_not_stop_the_
         s.requestSort()
         s.autoDt = False
         s.fixedDt = 1e-7
+        s.velocityUpdate = "pic"                          # v_p = Σ ψ_i v_i shows the grid's velocity at the particle
         s.run(1)
         v = ym.get(s, "vel")
         bot = (np.abs(x[:, 0] - xc) < c - 2 * h) & (np.abs(x[:, 1] - (xc - 1.25 * h)) < 1e-9)
