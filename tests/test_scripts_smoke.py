@@ -110,12 +110,14 @@ def test_mpi_scripts_on_one_process(tmp_path):
 
 
 def test_pic_dissipation_small(tmp_path):
-    """One Courant number, one wavelength, 20 µs: the CSV row, and bad input named."""
+    """One Courant number, one wavelength, 20 µs, both velocity updates: the CSV rows (FLIP keeps more), and bad
+    input named."""
     ok(run("pic_dissipation.py", "--out", tmp_path, "--courant", "1", "--wavelengths", "25", "--time", "2e-5"))
-    rows = list(csv.DictReader(open(tmp_path / "pic_dissipation.csv")))
-    assert len(rows) == 1 and 0.9 < float(rows[0]["energy_left"]) < 1.0
-    r = run("pic_dissipation.py", "--out", tmp_path, "--courant", "2")
-    assert r.returncode == 2 and "--courant" in r.stderr
+    rows = {r["velocity_update"]: float(r["energy_left"]) for r in csv.DictReader(open(tmp_path / "pic_dissipation.csv"))}
+    assert set(rows) == {"pic", "flip"} and 0.9 < rows["pic"] < rows["flip"] <= 1.0
+    for bad in (["--courant", "2"], ["--velocity-update", "apic"]):
+        r = run("pic_dissipation.py", "--out", tmp_path, *bad)
+        assert r.returncode == 2 and bad[0] in r.stderr
 
 
 def test_circular_opening_names_a_stopped_run_and_goes_on(tmp_path, monkeypatch):

@@ -16,10 +16,10 @@ enum class OutsidePolicy : int {
 MPM_CHOICES(OutsidePolicy, "stop|remove|remove-debris")
 // How G2P updates the particle velocity (doc/reference/algorithm.md, "The particle velocity update and C").
 enum class VelocityUpdate : int {
-	Flip = 0, // v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt; default)
-	Pic  = 1  // Eq. 6 as printed: v_p ← Σ ψ_i v_i (the paper's; loses a share of the sub-grid motion every step)
+	Pic  = 0, // Eq. 6 as printed: v_p ← Σ ψ_i v_i (the paper's; default; loses a share of the sub-grid motion every step)
+	Flip = 1  // v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt)
 };
-MPM_CHOICES(VelocityUpdate, "flip|pic")
+MPM_CHOICES(VelocityUpdate, "pic|flip")
 } // namespace mpm
 
 // X(type, name, default, unit, lo, hi, ends, symbol, doc, equation, gate); Vec = Dim<D>::Vec (per component)
@@ -34,9 +34,10 @@ MPM_CHOICES(VelocityUpdate, "flip|pic")
 	X(int, sortPeriod, 50, "steps", 1, 1e9, CC, "", "re-sort particles by block at least every this many steps", "", "")        \
 	X(Real, mpiRebalance, 1.1, "-", 1, INFINITY, CC, "", "MPI only: at each re-sort, cut the slabs again when the busiest rank holds more " \
 	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
-	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Flip, "-", 0, 1, CC, "", "particle velocity in G2P: 'flip' (default, "         \
-	  "v_p += Σ ψ_i Δv_i: no loss per step, results after cracking independent of C) or 'pic' (Eq. 6 as printed, the paper's, "  \
-	  "v_p = Σ ψ_i v_i: a share of the sub-grid motion lost every step); positions move with Σ ψ_i v_i either way", "Eq. 6", "") \
+	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Pic, "-", 0, 1, CC, "", "particle velocity in G2P: 'pic' (default, Eq. 6 as "  \
+	  "printed, v_p = Σ ψ_i v_i: a share of the sub-grid motion lost every step, so results after cracking depend on C) or "   \
+	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step, but nodal damping does not reach the "      \
+	  "particle's own velocity); positions move with Σ ψ_i v_i either way", "Eq. 6", "")                                      \
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
 	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
 	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \

@@ -61,8 +61,8 @@ def courant_option(ap):
     set on a solver by :func:`apply_step_options`."""
     ap.add_argument("--courant", type=float, default=None,
                     help=f"Courant number C of the step Δt = C·l/(v_c + max|v|) (default: the solver's, {setting_default('courant'):g})")
-    ap.add_argument("--velocity-update", choices=("flip", "pic"), default=None,
-                    help=f"particle velocity update in G2P: 'flip' or 'pic' (Eq. 6 as printed, the paper's) (default: the "
+    ap.add_argument("--velocity-update", choices=("pic", "flip"), default=None,
+                    help=f"particle velocity update in G2P: 'pic' (Eq. 6 as printed, the paper's) or 'flip' (default: the "
                          f"solver's, {setting_default('velocityUpdate')})")
 
 
