@@ -78,9 +78,11 @@ def test_resume_is_bitwise(tmp_path):
     assert ym.engine.by_label("mpmCk").solver is s
 
 
-def test_solver_only_resume_is_bitwise(tmp_path):
+@pytest.mark.parametrize("update", ["pic", "flip"])
+def test_solver_only_resume_is_bitwise(tmp_path, update):
     def make():
         s = ym.make_solver((0, 0), (0.2, 0.1), 0.01)
+        s.velocityUpdate = update                 # FLIP: v_p is state, Σ ψ_i v_i is recomputed each step
         ym.add_region(s, ym.rocks.granite(), (0, 0), (0.2, 0.1))
         s.addBoundaryPlane(1, -1, 0.0, "fixed")
         s.gravity, s.sortPeriod = (0, -9.81), 5

@@ -18,7 +18,7 @@ import json, math, sys
 import numpy as np
 import yade_mpm as ym
 from yade_mpm.fields import views
-dim, nsteps, flaws = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+dim, nsteps, flaws, update = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 mat = ym.rocks.granite_dpgk(flawCount=flaws, flawSeed=3)   # flaws > 0: Benz–Asphaug population
 l = 0.01
 if dim == 2:
@@ -35,6 +35,7 @@ s.addBoundaryPlane(1, -1, 0.0, "fixed")
 s.addBoundaryPlane(0, -1, 0.0, "slip")
 s.damping = 0.05
 s.sortPeriod = 7
+s.velocityUpdate = update
 # an excluded node in the interior (as rigid-body contact will do): general stencils around it
 pos = s._nodePositions()
 target = 0.4 * np.array(hi)
@@ -58,20 +59,20 @@ print("RESULT " + json.dumps(out))
 """
 
 
-def _run(dim, steps, threads, flaws=0):
+def _run(dim, steps, threads, flaws=0, update="pic"):
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     env["PYTHONPATH"] = os.path.join(root, "py") + os.pathsep + env.get("PYTHONPATH", "")
-    r = subprocess.run([sys.executable, "-c", CHILD, str(dim), str(steps), str(flaws)], env=env, capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-c", CHILD, str(dim), str(steps), str(flaws), update], env=env, capture_output=True, text=True,
                        timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
     line = [l for l in r.stdout.splitlines() if l.startswith("RESULT ")]
     return json.loads(line[-1][7:])
 
 
-@pytest.mark.parametrize("dim,steps,flaws", [(2, 120, 0), (3, 40, 0), (2, 120, 8)])
-def test_one_and_two_threads_bitwise_identical(dim, steps, flaws):
-    one, two = _run(dim, steps, 1, flaws), _run(dim, steps, 2, flaws)
+@pytest.mark.parametrize("dim,steps,flaws,update", [(2, 120, 0, "pic"), (3, 40, 0, "pic"), (2, 120, 8, "pic"), (2, 120, 0, "flip")])
+def test_one_and_two_threads_bitwise_identical(dim, steps, flaws, update):
+    one, two = _run(dim, steps, 1, flaws, update), _run(dim, steps, 2, flaws, update)
     if flaws:   # the flaw population is really used: partially damaged particles with some flaws active
         nf = np.frombuffer(bytes.fromhex(one["nFlaw"]), dtype=np.float64)
         assert np.any((nf > 0) & (nf < flaws)), "no particle with a partial flaw activation"
