@@ -80,9 +80,16 @@ public:
 	{
 		collect(gi, s);
 		share(gi, s);
-		solve(gi);
+		const Real scale = warmStart(gi, s.dt);
+		solve(gi, scale);
 		store(s.grid, gi);
 		reactions(gi, s.dt, 1);
+		keepImpulses(gi, s.dt);
+	}
+	// A step in which group gi had no work: its next contacts start from zero.
+	void idleKinematic(size_t gi)
+	{
+		if (gi < warm.size()) warm[gi].clear();
 	}
 	// After the late damping (dampAfterContact), one thread: the damped velocities meet the constraints again; the
 	// reactions are those of the total impulse.
@@ -92,10 +99,24 @@ public:
 		if (gi >= kcs.size()) return;
 		refresh(gi, s);
 		reactions(gi, s.dt, -1);
-		solve(gi);
+		solve(gi, 0);
 		store(s.grid, gi);
 		reactions(gi, s.dt, 1);
+		keepImpulses(gi, s.dt);
 	}
+
+	// The impulses the next step starts from (checkpoints): per group, particle ids (ascending), impulses, and the Δt
+	// of the step that found them.
+	struct WarmImpulse {
+		int64_t id;
+		Vec     lam; // [N s]
+	};
+	struct WarmStart {
+		std::vector<WarmImpulse> imp;
+		Real                     dt = 0; // [s]
+		void clear() { imp.clear(), dt = 0; }
+	};
+	std::vector<WarmStart> warm; // per group
 
 private:
 	std::vector<std::vector<KinematicContactRec<D>>> kcs;  // per group: its contacts this step (capacity kept between steps)
@@ -271,24 +292,76 @@ private:
 				for (int a = 0; a < D; ++a) grid.vel[t.local[j]].c[a] = t.v[j][a];
 	}
 
+	// Each contact starts from the impulse its particle had in the previous step, scaled by the ratio of the steps (a
+	// steady force keeps λ/Δt), applied to the node table and the free bodies as a sweep would: a light free body
+	// couples every contact, and Gauss–Seidel from zero then stops short of the solution by a Δt-dependent amount.
+	// Returns the largest relative speed before the start (the scale of solve's convergence test).
+	Real warmStart(size_t gi, Real dt)
+	{
+		auto&       kc    = kcs[gi];
+		const auto& t     = tabs[gi];
+		Real        scale = 0;
+		for (const auto& c : kc) scale = std::max(scale, relativeVelocity(c, t).norm());
+		if (gi >= warm.size() || warm[gi].imp.empty() || !(warm[gi].dt > 0)) return scale;
+		const auto& w  = warm[gi].imp;
+		const Real  sc = dt / warm[gi].dt;
+		for (auto& c : kc) {
+			const auto it = std::lower_bound(w.begin(), w.end(), c.id, [](const WarmImpulse& a, int64_t id) { return a.id < id; });
+			if (it != w.end() && it->id == c.id) applyImpulse(gi, c, sc * it->lam);
+		}
+		return scale;
+	}
+	void keepImpulses(size_t gi, Real dt)
+	{
+		if (warm.size() < groups.size()) warm.resize(groups.size());
+		auto& w = warm[gi];
+		w.imp.clear(), w.dt = dt;
+		for (const auto& c : kcs[gi])
+			if (!c.lam.isZero(0)) w.imp.push_back({ c.id, c.lam });
+		std::sort(w.imp.begin(), w.imp.end(), [](const WarmImpulse& a, const WarmImpulse& b) { return a.id < b.id; });
+	}
+	// u_p = v_p − (v + ω × r_p) of contact c over the node table (Eqs. 6, 26).
+	Vec relativeVelocity(const KinematicContactRec<D>& c, const KinematicNodeTable<D>& t) const
+	{
+		Vec vp = Vec::Zero();
+		for (int k = 0; k < c.nn; ++k)
+			for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * t.v[size_t(c.slot[k])][a];
+		return vp - parts[c.part].velocityAt(c.x) - dq[c.part].at(c.r);
+	}
+	// λ_c += dl: the nodes' velocities (free components) and the free body's motion (−dl at x_p).
+	void applyImpulse(size_t gi, KinematicContactRec<D>& c, const Vec& dl)
+	{
+		auto& t = tabs[gi];
+		c.lam += dl;
+		for (int k = 0; k < c.nn; ++k) {
+			const size_t  j   = size_t(c.slot[k]);
+			const uint8_t fix = t.fix[j];
+			for (int a = 0; a < D; ++a)
+				if (!((fix >> a) & 1)) t.v[j][a] += c.w[k][a] * c.invM[k] * dl[a];
+		}
+		const auto& q = parts[c.part];
+		if (q.movable()) {
+			dq[c.part].v -= dl / q.mass;
+			dq[c.part].w -= SpinOf<D>(q.inverseInertia() * momentOf<D>(c.r, dl));
+		}
+	}
+
 	// 3. projected Gauss–Seidel on the impulses of group gi over its node table (free parts' velocity changes in dq);
 	// continues from the impulses found so far, so a second call after the late damping restores the constraints.
-	void solve(size_t gi)
+	// scale0: a relative speed the convergence test is taken against (warmStart's), with the first sweep's.
+	void solve(size_t gi, Real scale0)
 	{
 		if (gi >= kcs.size()) return;
 		auto& t = tabs[gi];
 		const auto& g     = groups[gi];
 		auto&       kc    = kcs[gi];
 		const Real  mu    = g.params.mu;
-		Real        scale = 0;
+		Real        scale = scale0;
 		for (int sweep = 0; sweep < kinematicSweeps; ++sweep) {
 			Real worst = 0;
 			for (auto& c : kc) {
-				const auto& q  = parts[c.part];
-				Vec         vp = Vec::Zero();
-				for (int k = 0; k < c.nn; ++k)
-					for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * t.v[size_t(c.slot[k])][a];
-				const Vec u = vp - q.velocityAt(c.x) - dq[c.part].at(c.r); // u_p = v_p − (v + ω × r_p), Eqs. 6, 26
+				const auto& q = parts[c.part];
+				const Vec   u = relativeVelocity(c, t); // u_p = v_p − (v + ω × r_p), Eqs. 6, 26
 				if (sweep == 0) scale = std::max(scale, u.norm());
 				// normal
 				const Real kinvN = compliance(c, q, c.n);
@@ -307,20 +380,9 @@ private:
 				const Real cap = mu * ln + c.cap0; // ‖λ_t‖ ≤ μ λ_n + c a_p Δt
 				const Real ltn = lt.norm();
 				if (ltn > cap) lt *= cap / ltn; // slip at the limit (Eq. 24)
-				const Vec lam = ln * c.n + lt;
-				const Vec dl  = lam - c.lam;
+				const Vec dl = ln * c.n + lt - c.lam;
 				if (dl.isZero(0)) continue;
-				c.lam = lam;
-				for (int k = 0; k < c.nn; ++k) {
-					const size_t  j   = size_t(c.slot[k]);
-					const uint8_t fix = t.fix[j];
-					for (int a = 0; a < D; ++a)
-						if (!((fix >> a) & 1)) t.v[j][a] += c.w[k][a] * c.invM[k] * dl[a];
-				}
-				if (q.movable()) { // the free body takes −Δλ at x_p
-					dq[c.part].v -= dl / q.mass;
-					dq[c.part].w -= SpinOf<D>(q.inverseInertia() * momentOf<D>(c.r, dl));
-				}
+				applyImpulse(gi, c, dl); // the free body takes −Δλ at x_p
 				worst = std::max(worst, dl.norm() * kinvN);
 			}
 			if (worst <= kinematicTol * (scale + 1e-12)) break;

@@ -22,6 +22,8 @@ public:
 	{
 		ContactDetection<D>::beforeTransfer(s);
 		this->preparePenalty();
+		for (size_t gi = 0; gi < groups.size(); ++gi)
+			if (work[gi].skip) this->idleKinematic(gi); // no contacts this step: the next ones start from zero
 	}
 	template <class X>
 	void apply(const ContactStep<D, X>& s)

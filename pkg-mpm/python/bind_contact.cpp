@@ -223,6 +223,44 @@ struct ContactWrap {
 		return out;
 	}
 	static bool contactActive(S& s) { return s.contact.active(); }
+	// The kinematic law's warm start of group g (checkpoints): (particle ids, impulses (n, D) [N s], Δt of their step [s]).
+	static bp::tuple kinematicWarmStart(S& s, int g)
+	{
+		s.contact.group(g); // refuses a group that does not exist
+		const bool  has = size_t(g) < s.contact.warm.size();
+		const auto  n   = has ? s.contact.warm[size_t(g)].imp.size() : 0;
+		np::ndarray ids = np::empty(bp::make_tuple(n), np::dtype::get_builtin<int64_t>());
+		np::ndarray lam = np::empty(bp::make_tuple(n, D), np::dtype::get_builtin<double>());
+		auto*       pi  = reinterpret_cast<int64_t*>(ids.get_data());
+		auto*       pl  = reinterpret_cast<double*>(lam.get_data());
+		for (size_t k = 0; k < n; ++k) {
+			const auto& w = s.contact.warm[size_t(g)].imp[k];
+			pi[k]         = w.id;
+			for (int a = 0; a < D; ++a) pl[k * D + a] = w.lam[a];
+		}
+		return bp::make_tuple(ids, lam, has ? s.contact.warm[size_t(g)].dt : 0.0);
+	}
+	static void setKinematicWarmStart(S& s, int g, bp::object ids, bp::object lam, double dt)
+	{
+		s.contact.group(g); // refuses a group that does not exist
+		np::ndarray i = np::from_object(ids, np::dtype::get_builtin<int64_t>(), np::ndarray::C_CONTIGUOUS);
+		if (i.get_nd() != 1) throw InputError("warm-start ids must be a 1-D integer array");
+		const size_t n = size_t(i.shape(0));
+		np::ndarray  l = asDoubleArray(lam, "warm-start impulses", D, n);
+		if (!(dt >= 0 && std::isfinite(dt))) throw InputError("warm-start dt = " + fmtNum(dt) + " s must be finite and >= 0");
+		auto* pi = reinterpret_cast<const int64_t*>(i.get_data());
+		auto* pl = reinterpret_cast<const double*>(l.get_data());
+		for (size_t k = 1; k < n; ++k)
+			if (!(pi[k - 1] < pi[k])) throw InputError("warm-start ids must be strictly ascending");
+		auto& w = s.contact.warm;
+		if (w.size() < s.contact.groups.size()) w.resize(s.contact.groups.size());
+		auto& wg = w[size_t(g)];
+		wg.imp.resize(n), wg.dt = dt;
+		for (size_t k = 0; k < n; ++k) {
+			wg.imp[k].id = pi[k];
+			for (int a = 0; a < D; ++a) wg.imp[k].lam[a] = pl[k * D + a];
+		}
+	}
 
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
@@ -261,6 +299,9 @@ struct ContactWrap {
 		        .def("_contactQuery", &contactQuery, (bp::arg("group"), bp::arg("point")))
 		        .def("_contactGroupClosed", &contactGroupClosed, bp::arg("group"))
 		        .def("_contactNodeForces", &contactNodeForces)
+		        .def("_kinematicWarmStart", &kinematicWarmStart, bp::arg("group"),
+		             "(ids, impulses (n, D) [N s], dt [s]): the kinematic law's start of group g's next step (checkpoints)")
+		        .def("_setKinematicWarmStart", &setKinematicWarmStart, (bp::arg("group"), bp::arg("ids"), bp::arg("impulses"), bp::arg("dt")))
 		        .add_property("_contactActive", &contactActive);
 	}
 };

@@ -92,6 +92,9 @@ def _solver_state(solver):
     rs = solver._getResumeState()
     arrs["blockStart"] = np.array(rs["blockStart"], copy=True)
     arrs["scalars"] = np.array([float(rs[k]) for k in _STATE_SCALARS], dtype=np.float64)
+    for g in range(solver._numContactGroups):          # the kinematic law's start of the next step
+        ids, lam, dt = solver._kinematicWarmStart(g)
+        arrs[f"warm{g}_ids"], arrs[f"warm{g}_impulses"], arrs[f"warm{g}_dt"] = ids, lam, np.array([dt])
     return arrs
 
 
@@ -119,6 +122,9 @@ def _restore_solver(solver, arrs, settings):
     except ValueError as e:
         solver.setSettings(old)
         raise CheckpointError(f"checkpoint: {e}") from None
+    for g in range(solver._numContactGroups):
+        if f"warm{g}_ids" in arrs:                  # absent in a checkpoint saved before the warm start existed
+            solver._setKinematicWarmStart(g, arrs[f"warm{g}_ids"], arrs[f"warm{g}_impulses"], float(arrs[f"warm{g}_dt"][0]))
     for k, v in views.items():
         if k != "material":                       # read-only view: set below through the API
             np.copyto(v, arrs[k])
