@@ -24,10 +24,12 @@ def _run(variant, h, cells, steps, **kw):
     return s, sc, np.array(curve).T
 
 
-@pytest.mark.parametrize("law, tol", [("penalty", 1e-10), ("kinematic", 2e-5)])
+@pytest.mark.parametrize("law, tol", [("penalty", 1e-10), ("kinematic", 1e-4)])
 def test_slab_is_plane_strain_to_roundoff(law, tol):
     """penalty: to roundoff; kinematic: the platen layer's impulses come from an iterative solve (projected
-    Gauss–Seidel to 1e-6 of the contact speed) whose sweep order differs between 2D and the slab: measured 4.3e-6."""
+    Gauss–Seidel to 1e-6 of the contact speed) whose sweep order differs between 2D and the slab: measured 4.3e-6
+    from a cold start each step, 5.6e-5 warm-started (each step starts from the last one's impulses, so the
+    difference is carried on); doc/reference/contact.md: the two models agree to about 1e-4."""
     h, cells = 0.004, 2                        # the coarsest grid the 2 mm flaw allows
     s2, _, c2 = _run("open", h, 0, 60, platen_d0=h / 4, contact_law=law)
     s3, sc3, c3 = _run("open", h, cells, 60, platen_d0=h / 4, contact_law=law)
@@ -44,7 +46,9 @@ def test_slab_is_plane_strain_to_roundoff(law, tol):
         dz.append(np.ptp(x3[layer, 2]))
     vz = np.abs(v3[:, 2]).max() / np.abs(v2).max()
     print(f"{law}: curve {np.abs(c3 - c2).max() / np.abs(c2[1]).max():.2e}, layer velocities {max(dv):.2e}, z spread {max(dz):.2e} m, vz {vz:.2e}")
-    assert max(dv) < 1e-10 if law == "penalty" else max(dv) < 1e-4
+    # kinematic: the layers' velocities 5.4e-4 apart warm-started (under 1e-4 before; 2.8e-4 with 200 sweeps: the split of the
+    # impulses among contacts that share nodes is not unique, and the warm start carries each model's split on)
+    assert max(dv) < 1e-10 if law == "penalty" else max(dv) < 1e-3
     assert max(dz) < 1e-12 if law == "penalty" else max(dz) < 1e-9
     assert vz < 1e-10 if law == "penalty" else vz < 1e-4       # no motion across the slip planes
 
