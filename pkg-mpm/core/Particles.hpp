@@ -163,9 +163,9 @@ struct Particles {
 			for (int a = 0; a < D; ++a) e += 0.5 * mass[p] * v[a][p] * v[a][p];
 		return e;
 	}
-	// Work of gravity g and the surface forces (× loadScale) on the particles over dt, Σ (m g + s f)·v dt [J].
+	// Work of gravity g and the surface forces (× loadScale) on the particles over dt, Σ (m g + s f)·u dt [J], u the
+	// velocity each particle moved with (v, or FLIP's Transfer::vg).
 	template <class Vec>
-	// Work of gravity and tractions over a step in which particle p moved by Δt u[a][p] (u: v, or FLIP's vg).
 	Real externalWork(const Vec& g, Real loadScale, Real dt, const std::vector<Real> (&u)[D]) const
 	{
 		Real w = 0;

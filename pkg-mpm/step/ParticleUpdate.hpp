@@ -120,11 +120,11 @@ inline std::string leftGridMessage(const Particles<D>& P, const Grid<D>& grid, s
 	       + ") m (grid spans [" + fmtNum(lo[a]) + ", " + fmtNum(hi[a]) + ") m along axis " + std::to_string(a) + ")";
 }
 
-// x ← x + Δt v (the G2P velocity; flip: Σ ψ_i v_i, Transfer::vg) for the particles of block b. Raises v2max by ‖v_p‖². Checks that each stays finite and on the
-// grid cut by the boundary planes (else err; a particle past the grid's edge goes to err.left, for the
+// x ← x + Δt v (the G2P velocity; flip: Σ ψ_i v_i, Transfer::vg) for the particles of block b. Checks that each
+// stays finite and on the grid cut by the boundary planes (else err; a particle past the grid's edge goes to err.left, for the
 // solver's outside policy) and within the cells its block may reach before a re-sort
 // (BlockSchedule::reach): drift is set when one left them, so the deterministic colouring stays valid.
-// Raises v2max to the largest ‖v‖² (for Δt). A branch-free loop over the arrays; the messages are built
+// Raises v2max to the largest ‖v_p‖² (for Δt). A branch-free loop over the arrays; the messages are built
 // only when a particle failed.
 template <int D>
 inline void moveParticles(const Transfer<D>& tr, Real dt, uint32_t b, bool flip, Real& v2max, int& drift, ErrorRecord& err)

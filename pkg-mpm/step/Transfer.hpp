@@ -171,7 +171,7 @@ public:
 		if (flip) g2pPass<true>(err);
 		else g2pPass<false>(err);
 	}
-	mutable std::vector<Real> vg[D]; // flip only: Σ ψ_i v_i of the last G2P, the velocity of the position update [m/s]
+	std::vector<Real> vg[D]; // flip only: Σ ψ_i v_i of the last G2P, the velocity of the position update [m/s]
 
 	template <bool flip>
 	void g2pPass(ErrorRecord& err)
