@@ -172,7 +172,8 @@ public:
 		errP2G.clear(), errContact.clear(), errG2P.clear();
 		const ContactStep<D, StepExchange<D>> cs { grid, P, sched, xfer.offs, dt, massFloor, errContact, exchange };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
-			                     liveViews > 0 || viewTaken, velocityUpdate == VelocityUpdate::Flip }; // viewWrites: P2G checks what views may have changed
+			                     liveViews > 0 || viewTaken,                 // viewWrites: P2G checks what views may have changed
+			                     velocityUpdate == VelocityUpdate::Flip };
 		if (in.flip)
 			for (auto& c : xfer.vg) c.resize(P.n); // grows only with the particle count
 		if (in.withContact) contact.beforeTransfer(cs);
@@ -193,7 +194,7 @@ public:
 		});
 		phase.sort += t[0] - t0, phase.p2g += t[1] - t[0], phase.grid += t[2] - t[1], phase.contact += t[3] - t[2];
 		phase.g2p += t[4] - t[3], phase.stress += t[5] - t[4];
-		if (trackEnergy) accumulateExternalWork(dt);
+		if (trackEnergy) accumulateExternalWork(dt, in.flip);
 		time += dt;
 		lastDt = dt;
 		++steps;
@@ -378,9 +379,9 @@ private:
 		}
 	}
 
-	void accumulateExternalWork(Real dt)
+	void accumulateExternalWork(Real dt, bool flip)
 	{
-		Real w = P.externalWork(gravity, loadScale(time + dt), dt, velocityUpdate == VelocityUpdate::Flip ? xfer.vg : P.v); // the motion's velocity
+		Real w = P.externalWork(gravity, loadScale(time + dt), dt, flip ? xfer.vg : P.v); // along the velocity the particles moved with
 		MPM_IF_MPI(w = dd.sum(w);) // MPI: the work on every rank's particles
 		externalWork += w;
 	}

@@ -71,7 +71,7 @@ def apply_step_options(solver, args):
     `solver`; returns them as a dict for a run's record."""
     if args.courant is not None:
         solver.courant = args.courant
-    if getattr(args, "velocity_update", None) is not None:
+    if args.velocity_update is not None:
         solver.velocityUpdate = args.velocity_update
     return dict(courant=solver.courant, velocity_update=solver.velocityUpdate)
 
