@@ -129,7 +129,7 @@ def test_solver_settings_declared_once_with_unit_range_and_doc():
     """Settings are generated from one declaration (SolverSettings.hpp): each property's docstring
     carries its unit and range, and bad values are refused with the name and the range."""
     names = set(_scene().settings())
-    assert names == {"gravity", "damping", "courant", "autoDt", "fixedDt", "tractionRampTime", "sortPeriod", "mpiRebalance", "trackEnergy", "outside", "velocityUpdate", "flipMemory"}
+    assert names == {"gravity", "damping", "courant", "autoDt", "fixedDt", "tractionRampTime", "sortPeriod", "mpiRebalance", "trackEnergy", "outside", "velocityUpdate"}
     for n in names | {"time", "externalWork"}:
         doc = getattr(ym.Solver2D, n).__doc__
         assert "[" in doc and ("range" in doc or "True or False" in doc or "one of" in doc), n

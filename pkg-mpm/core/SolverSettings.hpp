@@ -36,13 +36,8 @@ MPM_CHOICES(VelocityUpdate, "pic|flip")
 	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
 	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Pic, "-", 0, 1, CC, "", "particle velocity in G2P: 'pic' (default, Eq. 6 as "  \
 	  "printed, v_p = Σ ψ_i v_i: a share of the sub-grid motion lost every step, so results after cracking depend on C) or "   \
-	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step; the sub-grid part of v_p decays over "     \
-	  "flipMemory); positions move with Σ ψ_i v_i either way", "Eq. 6", "")                                      \
-	X(Real, flipMemory, 30, "l/v_c", 0, INFINITY, OC, "τ", "'flip' only: the part of a particle's velocity the grid cannot "  \
-	  "represent (v_p − Σ ψ_i vold_i) decays as exp(−t/τ), τ = flipMemory cell-crossing times l/(v_c + max‖v‖), the same " \
-	  "loss per unit time at any C, and by (1 − damping) per step; inf: never (pure FLIP, as Graphyt). Default 30, chosen " \
-	  "by measurement: pure FLIP lets that part grow next to a contact near its friction limit (a block at 96 % of it "   \
-	  "creeps 0.14 cell in 0.3 s), 30 holds it (0.003 cell) and costs 0.1–0.2 % of a 25-cell wave's energy", "", "")       \
+	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step, but nodal damping does not reach the "      \
+	  "particle's own velocity); positions move with Σ ψ_i v_i either way", "Eq. 6", "")                                      \
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
 	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
 	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \

@@ -33,7 +33,6 @@ struct StepInputs {
 	typename Dim<D>::Vec gravity;                           // [m/s²]
 	bool                 withContact, mirrors, viewWrites;  // rigid bodies, symmetry planes, state written through views
 	bool                 flip;                              // velocityUpdate 'flip': G2P needs the velocities before the step
-	Real                 flipKept;                          // flip: share of v_p − Σ ψ_i vold_i kept this step (Solver::flipKept) [-]
 };
 
 // Wall clock of the phase ends (master thread), for Solver::phase.
@@ -78,7 +77,7 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 			}
 			stampTime(t[3]);
 			if (errContact.none()) {
-				xfer.g2p(errG2P, in.flip, in.flipKept); // 4: Eqs. 6–7 (or FLIP), MUSL momentum (Eq. 16)
+				xfer.g2p(errG2P, in.flip); // 4: Eqs. 6–7 (or FLIP), MUSL momentum (Eq. 16)
 				ex.sumShared(grid, grid.mom, errG2P, "G2P"); // + the other processes' partial sums
 				if (errG2P.none()) {
 					if (in.mirrors) grid.mirrors.fold(grid.mom);

@@ -173,7 +173,7 @@ public:
 		const ContactStep<D, StepExchange<D>> cs { grid, P, sched, xfer.offs, dt, massFloor, errContact, exchange };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
 			                     liveViews > 0 || viewTaken,                 // viewWrites: P2G checks what views may have changed
-			                     velocityUpdate == VelocityUpdate::Flip, flipKept(dt, lim) };
+			                     velocityUpdate == VelocityUpdate::Flip };
 		if (in.flip)
 			for (auto& c : xfer.vg) c.resize(P.n); // grows only with the particle count
 		if (in.withContact) contact.beforeTransfer(cs);
@@ -379,10 +379,6 @@ private:
 		}
 	}
 
-	// Share of a particle's sub-grid velocity (v_p − Σ ψ_i vold_i, FLIP) kept by a step dt: exp(−Δt/τ), τ = flipMemory
-	// cell-crossing times l/(v_c + max‖v‖) = flipMemory · lim / C (lim = C·l/(v_c + max‖v‖), the stable step), so the same
-	// share per unit time at any C; × (1 − α), as the nodal damping leaves of the grid's acceleration.
-	Real flipKept(Real dt, Real lim) const { return (1 - damping) * std::exp(-dt * courant / (flipMemory * lim)); }
 	void accumulateExternalWork(Real dt, bool flip)
 	{
 		Real w = P.externalWork(gravity, loadScale(time + dt), dt, flip ? xfer.vg : P.v); // along the velocity the particles moved with

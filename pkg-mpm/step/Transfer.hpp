@@ -166,17 +166,15 @@ public:
 	// flip (Solver.velocityUpdate): v_p ← v_p + Σ ψ_i (v_i − vold_i) instead of Eq. 6, and vg ← Σ ψ_i v_i, the
 	// velocity the particle moves with (moveParticles). The MUSL remap spreads Σ ψ_i v_i either way, so the strain
 	// (from the remap) and the motion come from one field, the one the contact and the boundary planes constrained.
-	// kept (flip only, StepInputs::flipKept): the share of the part of v_p the grid cannot represent, v_p − Σ ψ_i vold_i,
-	// that this step keeps (1: pure FLIP, 0: Eq. 6).
-	void g2p(ErrorRecord& err, bool flip, Real kept)
+	void g2p(ErrorRecord& err, bool flip)
 	{
-		if (flip) g2pPass<true>(err, kept);
-		else g2pPass<false>(err, kept);
+		if (flip) g2pPass<true>(err);
+		else g2pPass<false>(err);
 	}
 	std::vector<Real> vg[D]; // flip only: Σ ψ_i v_i of the last G2P, the velocity of the position update [m/s]
 
 	template <bool flip>
-	void g2pPass(ErrorRecord& err, Real kept)
+	void g2pPass(ErrorRecord& err)
 	{
 		const KernelGeom<D> geo(grid);
 		scatterBlocks([&](uint32_t blk) {
@@ -188,7 +186,7 @@ public:
 				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
 				computeKernel<D, false>(g, x, k);
 				if (k.general) {
-					g2pCut<flip>(p, k, err, kept);
+					g2pCut<flip>(p, k, err);
 					continue;
 				}
 				const Real m = P.mass[p];
@@ -197,7 +195,7 @@ public:
 				if constexpr (flip) {
 					Real vo[D], Co[D][D];
 					gatherPacked(grid, grid.vold, k, g.gradFactor, vo, Co); // the same fit of the velocities before the step
-					flipVelocity(p, v, vo, C, kept);
+					flipVelocity(p, v, vo, C);
 				} else storeVelocity(p, v, C);
 				Real mvv[D], mc[D][D]; // m h_p(x_i) = m (v + ∇v (x_i − x_p))
 				for (int a = 0; a < D; ++a) {
@@ -289,7 +287,7 @@ private:
 	// conserved; exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 	// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
 	template <bool flip>
-	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, ErrorRecord& err, Real kept)
+	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, ErrorRecord& err)
 	{
 		Stencil<D> st;
 		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
@@ -306,7 +304,7 @@ private:
 			forStencil(grid.vold.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
 				for (int a = 0; a < D; ++a) vo[a] += st.eta[n] * nd.c[a];
 			});
-			flipVelocity(p, v, vo, C, kept);
+			flipVelocity(p, v, vo, C);
 		} else storeVelocity(p, v, C);
 		forStencil(grid.mom.data(), offs, st, [&](NodeVec<D>& nd, int n, const Real(&dx)[D]) {
 			const Real wm = st.w[n] * m;
@@ -317,12 +315,11 @@ private:
 			}
 		});
 	}
-	// FLIP: vg ← v (= Σ ψ_i v_i, the motion), v_p ← v + kept (v_p − vo): the particle keeps (a share of) what the grid
-	// cannot represent.
-	void flipVelocity(size_t p, const Real (&v)[D], const Real (&vo)[D], const Real (&C)[D][D], Real kept)
+	// FLIP: vg ← v (= Σ ψ_i v_i, the motion), v_p ← v_p + v − vo (the particle keeps what the grid cannot represent).
+	void flipVelocity(size_t p, const Real (&v)[D], const Real (&vo)[D], const Real (&C)[D][D])
 	{
 		Real vf[D];
-		for (int a = 0; a < D; ++a) vg[a][p] = v[a], vf[a] = v[a] + kept * (P.v[a][p] - vo[a]);
+		for (int a = 0; a < D; ++a) vg[a][p] = v[a], vf[a] = P.v[a][p] + (v[a] - vo[a]);
 		storeVelocity(p, vf, C);
 	}
 	// The stress-pass gather of a cut stencil (velocityGradient).

@@ -116,7 +116,6 @@ def _restore_solver(solver, arrs, settings):
     old = solver.settings()
     settings = dict(settings)
     settings.setdefault("velocityUpdate", "pic")  # saved before the setting existed: those runs used Eq. 6
-    settings.setdefault("flipMemory", float("inf"))  # saved before it existed: FLIP kept its sub-grid velocity
     try:
         solver.setSettings(settings)              # all or nothing, each value checked against its range
         solver._setResumeState(sc)                 # checks the block schedule before changing anything
