@@ -81,8 +81,7 @@ STICKING = [(2, 20, 0.5, 0.01, 0.0), (3, 20, 0.5, 0.01, 0.0),
             # 1e-5 to 1.1e-4 cell over 0.3 s on the 8 shifts).
             (2, 30, 0.6, 0.01, 0.05),
             # 3 % inside the friction limit (tan 28° = 0.532, μ = 0.55), from the block's own equilibrium: measured under
-            # the kinematic law at the default C = 0.5 2e-5 to 1.4e-3 cell over 0.3 s on the 8 shifts. At C = 1 two of the
-            # 8 shifts creep 0.21 and 0.24 cell (the others ≤ 2.9e-3): C = 1 does not hold this bar yet.
+            # the kinematic law at the default C = 0.5 0 to 4e-5 cell over 0.3 s on the 8 shifts (at C = 1: below).
             (2, 28, 0.55, 0.01, 0.05)]
 
 
@@ -104,6 +103,26 @@ def test_sticking_from_equilibrium_on_every_grid_shift(d, theta, mu, limit, rela
     print(f"d={d} θ={theta} μ={mu}: drift [cells] = {np.round(drifts, 5)}, lift [cells] = {np.round(lifts, 3)}")
     assert np.max(drifts) <= limit
     assert np.max(lifts) <= 0.1
+
+
+def test_near_limit_block_holds_at_courant_one():
+    """The 28°/μ 0.55 block of STICKING (3 % inside the limit, from its own equilibrium) at C = 1 on the 8 shifts. Before
+    the kinematic law corrected the MUSL remap (KinematicContact::constrainRemap) the strain came from remapped velocities
+    that slip where the motion did not: 2 of the 8 shifts crept 0.22 and 0.24 cell in 0.3 s (C = 0.75 already 0.085),
+    velocities growing from the block's free corner. Measured after: 0 to 4e-5 cell."""
+    th, drifts = np.radians(28), []
+    for sh in SHIFTS:
+        s, R, c0, l = _block(2, th, 0.55, sh, prestress=True)
+        s.courant = 1.0
+        s.damping = 0.3
+        while s.time < 0.05:
+            s.run(1)
+        s.damping = 0.0
+        h, lift = _run(s, 2, R, c0, l, 0.35)
+        drifts.append(np.abs(h[:, 1] - h[0, 1]).max() / l)
+        assert lift / l <= 0.1
+    print(f"C = 1, θ = 28°, μ = 0.55: drift [cells] = {np.round(drifts, 5)}")
+    assert max(drifts) <= 0.01
 
 
 def _xy_by_id(s):

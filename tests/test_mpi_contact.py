@@ -78,8 +78,10 @@ def _run(tmp_path, tag, steps, ranks, child=CHILD):
 # Agreement with 1 process: round-off of the sums added in another order, amplified by the scene. The kinematic law
 # (a constraint switched on at a touching threshold) amplifies it more than the penalty law; Cundall damping
 # (f − α|f| sign v, discontinuous where a nodal velocity crosses 0) far more, for both laws (penalty with damping 0.05:
-# 6e-6 on this scene), so with damping the bar only says the ranks follow 1 process.
-@pytest.mark.parametrize("law,damping,bar", [("penalty", 0, 1e-10), ("kinematic", 0, 1e-9), ("kinematic", 0.05, 1e-4)])
+# 6e-6 on this scene), so with damping the bar only says the ranks follow 1 process. Kinematic, no damping: fields
+# 3.7e-10 before the law corrected the MUSL remap, 1.04e-9 after (impulses 1.7e-12, filler velocity 4.8e-12 after,
+# 1.0e-11 and 1.7e-12 before): the correction adds sums of its own, hence a bar of 3e-9 for the fields.
+@pytest.mark.parametrize("law,damping,bar", [("penalty", 0, 1e-10), ("kinematic", 0, 3e-9), ("kinematic", 0.05, 1e-4)])
 def test_bodies_two_ranks_match_one(tmp_path, law, damping, bar):
     child = _child(law, damping)
     assert child.count(f'law="{law}"') == 3

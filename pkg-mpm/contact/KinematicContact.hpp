@@ -19,6 +19,8 @@ constexpr Real kinematicTouch = 1e-3;
 // correction of a sweep falls below kinematicTol × (the largest relative speed before the sweeps + 1e-12 m/s).
 constexpr int  kinematicSweeps = 60;
 constexpr Real kinematicTol    = 1e-6;
+// The remap correction (constrainRemap): its targets are consistent, so it converges to round-off (same stop on MPI).
+constexpr Real kinematicRemapTol = 1e-12;
 
 template <int D, class Base>
 class KinematicContact : public Base {
@@ -41,7 +43,7 @@ public:
 		share(gi, s);
 		const Real scale = warmStart(gi, s.dt);
 		solve(gi, scale);
-		store(s.grid, gi);
+		store(s.grid.vel, gi);
 		reactions(gi, s.dt, 1);
 		keepImpulses(gi, s.dt);
 	}
@@ -56,29 +58,53 @@ public:
 	void reprojectKinematic(size_t gi, const ContactStep<D, X>& s)
 	{
 		if (gi >= kcs.size()) return;
-		refresh(gi, s);
+		refresh(gi, s, s.grid.vel);
 		reactions(gi, s.dt, -1);
 		solve(gi, 0);
-		store(s.grid, gi);
+		store(s.grid.vel, gi);
 		reactions(gi, s.dt, 1);
 		keepImpulses(gi, s.dt);
 	}
 
-	// The impulses the next step starts from (checkpoints): per group, particle ids (ascending), impulses, and the Δt
-	// of the step that found them.
-	struct WarmImpulse {
-		int64_t id;
-		Vec     lam; // [N s]
-	};
-	struct WarmStart {
-		std::vector<WarmImpulse> imp;
-		Real                     dt = 0; // [s]
-		void clear() { imp.clear(), dt = 0; }
-	};
-	std::vector<WarmStart> warm; // per group
+	// After the MUSL remap (Eqs. 16–17), one thread: group gi's nodes' vmusl corrected (Gauss–Seidel, the per-axis
+	// compliance of the solve; bodies and reactions untouched) so each contact's Σ_k rd_k ṽ_k is the velocity the
+	// contact gave its particle: the strain (phase 6) follows the constrained motion. Uncorrected, the remap hands the
+	// strain a field that approaches and slips where the motion did not (doc/reference/contact.md).
+	template <class X>
+	void constrainRemap(size_t gi, const ContactStep<D, X>& s)
+	{
+		if (gi >= kcs.size()) return;
+		auto& t  = tabs[gi];
+		auto& kc = kcs[gi];
+		remapTarget.resize(kc.size());
+		Real scale = 0;
+		for (size_t j = 0; j < kc.size(); ++j) remapTarget[j] = particleVelocity(kc[j], t), scale = std::max(scale, remapTarget[j].norm());
+		refresh(gi, s, s.grid.vmusl);
+		for (int sweep = 0; sweep < kinematicSweeps; ++sweep) {
+			Real worst = 0;
+			for (size_t j = 0; j < kc.size(); ++j) {
+				const auto& c  = kc[j];
+				const Vec   du = remapTarget[j] - particleVelocity(c, t);
+				worst          = std::max(worst, du.norm());
+				for (int k = 0; k < c.nn; ++k) {
+					const size_t  sl  = size_t(c.slot[k]);
+					const uint8_t fix = t.fix[sl];
+					for (int a = 0; a < D; ++a)
+						if (!((fix >> a) & 1) && c.kinvAxis[a] > 0) t.v[sl][a] += c.w[k][a] * c.invM[k] * du[a] / c.kinvAxis[a];
+				}
+			}
+			if (worst <= kinematicRemapTol * (scale + 1e-12)) break;
+		}
+		store(s.grid.vmusl, gi);
+	}
+
+	// The impulses the next step starts from (checkpoints; KinematicRecords.hpp).
+	using WarmImpulse = KinematicWarmImpulse<D>;
+	std::vector<KinematicWarmStart<D>> warm; // per group
 
 private:
 	std::vector<std::vector<KinematicContactRec<D>>> kcs;  // per group: its contacts this step (capacity kept between steps)
+	std::vector<Vec>                                 remapTarget; // scratch of constrainRemap: each contact's particle velocity
 	std::vector<KinematicNodeTable<D>>               tabs; // per group: the nodes of its contacts
 
 	// The body's velocity change per unit impulse e at r (free part; 0 for a prescribed one): W_B J e.
@@ -226,29 +252,30 @@ private:
 		}
 	}
 
-	// The table's velocities from the grid again (after the late damping): each process sends those of the nodes it owns.
+	// The table's velocities from the grid again (of vel after the late damping, of vmusl after the remap): each process
+	// sends those of the nodes it owns.
 	template <class X>
-	void refresh(size_t gi, const ContactStep<D, X>& s)
+	void refresh(size_t gi, const ContactStep<D, X>& s, const std::vector<NodeVec<D>>& arr)
 	{
 		auto& t = tabs[gi];
 		t.upd.clear();
 		for (size_t j = 0; j < t.node.size(); ++j)
 			if (t.local[j] != SIZE_MAX && s.exchange.owns(t.local[j])) {
 				typename KinematicNodeTable<D>::Update u { j, {} };
-				for (int a = 0; a < D; ++a) u.v[a] = s.grid.vel[t.local[j]].c[a];
+				for (int a = 0; a < D; ++a) u.v[a] = arr[t.local[j]].c[a];
 				t.upd.push_back(u);
 			}
 		s.exchange.gatherInOrder(t.upd);
 		for (const auto& u : t.upd)
 			for (int a = 0; a < D; ++a) t.v[u.slot][a] = u.v[a];
 	}
-	// The table's velocities into the nodes this process holds.
-	void store(Grid<D>& grid, size_t gi) const
+	// The table's velocities into arr (vel or vmusl) at the nodes this process holds.
+	void store(std::vector<NodeVec<D>>& arr, size_t gi) const
 	{
 		const auto& t = tabs[gi];
 		for (size_t j = 0; j < t.node.size(); ++j)
 			if (t.local[j] != SIZE_MAX)
-				for (int a = 0; a < D; ++a) grid.vel[t.local[j]].c[a] = t.v[j][a];
+				for (int a = 0; a < D; ++a) arr[t.local[j]].c[a] = t.v[j][a];
 	}
 
 	// Each contact starts from the impulse its particle had in the previous step, scaled by the ratio of the steps (a
@@ -282,10 +309,7 @@ private:
 	// u_p = v_p − (v + ω × r_p) of contact c over the node table (Eqs. 6, 26).
 	Vec relativeVelocity(const KinematicContactRec<D>& c, const KinematicNodeTable<D>& t) const
 	{
-		Vec vp = Vec::Zero();
-		for (int k = 0; k < c.nn; ++k)
-			for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * t.v[size_t(c.slot[k])][a];
-		return vp - parts[c.part].velocityAt(c.x) - dq[c.part].at(c.r);
+		return particleVelocity(c, t) - parts[c.part].velocityAt(c.x) - dq[c.part].at(c.r);
 	}
 	// λ_c += dl: the nodes' velocities (free components) and the free body's motion (−dl at x_p).
 	void applyImpulse(size_t gi, KinematicContactRec<D>& c, const Vec& dl)

@@ -49,4 +49,28 @@ struct KinematicNodeTable {
 	std::vector<Update> upd;
 };
 
+// v_p = Σ_k rd_k v_k of contact c over the node table t (Eq. 6).
+template <int D>
+typename Dim<D>::Vec particleVelocity(const KinematicContactRec<D>& c, const KinematicNodeTable<D>& t)
+{
+	typename Dim<D>::Vec vp = Dim<D>::Vec::Zero();
+	for (int k = 0; k < c.nn; ++k)
+		for (int a = 0; a < D; ++a) vp[a] += c.rd[k][a] * t.v[size_t(c.slot[k])][a];
+	return vp;
+}
+
+// The impulses the next step starts from (checkpoints): per group, particle ids (ascending), impulses, and the Δt of
+// the step that found them.
+template <int D>
+struct KinematicWarmImpulse {
+	int64_t              id;
+	typename Dim<D>::Vec lam; // [N s]
+};
+template <int D>
+struct KinematicWarmStart {
+	std::vector<KinematicWarmImpulse<D>> imp;
+	Real                                 dt = 0; // [s]
+	void                                 clear() { imp.clear(), dt = 0; }
+};
+
 } // namespace mpm

@@ -1,7 +1,8 @@
 // The contact phase of the step (paper Sec. 2.3, Eqs. 23–26; Fig. 1b): particle-to-surface (PTS) frictional contact
 // of the particles with rigid surfaces, group by group with each group's law. beforeTransfer (serial, before P2G)
 // places the bodies and excludes the nodes they cover; apply (every thread, between gridUpdate and g2p) corrects the
-// nodal velocities and sums the reactions; reproject (after the late damping) runs the kinematic groups again.
+// nodal velocities and sums the reactions; reproject (after the late damping) runs the kinematic groups again;
+// afterRemap corrects the MUSL velocities at the kinematic groups' nodes.
 // The ContactStep's exchange policy (core/Exchange.hpp) carries what a distributed run shares.
 #pragma once
 #include "KinematicContact.hpp"
@@ -51,6 +52,18 @@ public:
 				sumReactions(s.exchange);
 				for (size_t p = 0; p < parts.size(); ++p) parts[p].force += kept[p].force, parts[p].torque += kept[p].torque;
 			}
+		});
+	}
+
+	// After the MUSL remap (every thread): the kinematic groups correct the remapped velocities at their nodes so the
+	// strain follows the constrained motion (KinematicContact::constrainRemap).
+	template <class X>
+	void afterRemap(const ContactStep<D, X>& s)
+	{
+		if (!hasKinematic()) return;
+		s.exchange.oneThread([&] {
+			for (size_t gi = 0; gi < groups.size(); ++gi)
+				if (groups[gi].params.law == ContactLaw::Kinematic && !work[gi].skip) this->constrainRemap(gi, s);
 		});
 	}
 

@@ -1,5 +1,5 @@
 // One explicit WLS-MPM step with MUSL (paper Sec. 2.5, Fig. 2), the whole step in order: gridPhases (1 P2G,
-// 2 grid update, 3 contact, 4 G2P, 5 MUSL remap, in one parallel region) and particlePhases (6 stress update,
+// 2 grid update, 3 contact, 4 G2P, 5 MUSL remap (+ the kinematic contact's correction), in one parallel region) and particlePhases (6 stress update,
 // 7 positions, in one loop over blocks); the loops live in the headers they call. A table of the phases, their
 // equations and the node arrays each writes: doc/developer/core_notes.md.
 #pragma once
@@ -82,6 +82,7 @@ inline void gridPhases(Transfer<D>& xfer, Contact& contact, const ContactStep<D,
 				if (errG2P.none()) {
 					if (in.mirrors) grid.mirrors.fold(grid.mom);
 					gridMusl(grid, in.massFloor); // 5: Eq. 17
+					if (in.withContact) contact.afterRemap(cs); // kinematic law: the remap keeps the constraints
 					if (in.mirrors) grid.mirrors.unfold(grid.vmusl);
 				}
 			}
