@@ -19,8 +19,6 @@ constexpr Real kinematicTouch = 1e-3;
 // correction of a sweep falls below kinematicTol × (the largest relative speed before the sweeps + 1e-12 m/s).
 constexpr int  kinematicSweeps = 60;
 constexpr Real kinematicTol    = 1e-6;
-// The remap correction (constrainRemap): its targets are consistent, so it converges to round-off (same stop on MPI).
-constexpr Real kinematicRemapTol = 1e-12;
 
 template <int D, class Base>
 class KinematicContact : public Base {
@@ -93,7 +91,7 @@ public:
 						if (!((fix >> a) & 1) && c.kinvAxis[a] > 0) t.v[sl][a] += c.w[k][a] * c.invM[k] * du[a] / c.kinvAxis[a];
 				}
 			}
-			if (worst <= kinematicRemapTol * (scale + 1e-12)) break;
+			if (worst <= kinematicTol * (scale + 1e-12)) break;
 		}
 		store(s.grid.vmusl, gi);
 	}
