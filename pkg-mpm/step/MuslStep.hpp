@@ -1,7 +1,7 @@
 // One explicit WLS-MPM step with MUSL (paper Sec. 2.5, Fig. 2), the whole step in order: gridPhases (1 P2G,
-// 2 grid update, 3 contact, 4 G2P, 5 MUSL remap (+ the kinematic contact's correction), in one parallel region) and particlePhases (6 stress update,
-// 7 positions, in one loop over blocks); the loops live in the headers they call. A table of the phases, their
-// equations and the node arrays each writes: doc/developer/core_notes.md.
+// 2 grid update, 3 contact, 4 G2P, 5 MUSL remap and the kinematic contact's correction of it, in one parallel region)
+// and particlePhases (6 stress update, 7 positions, in one loop over blocks); the loops live in the headers they call.
+// A table of the phases, their equations and the node arrays each writes: doc/developer/core_notes.md.
 #pragma once
 #include "../contact/PtsContact.hpp"
 #include "GridUpdate.hpp"
