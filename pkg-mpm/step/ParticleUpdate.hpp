@@ -121,8 +121,8 @@ inline std::string leftGridMessage(const Particles<D>& P, const Grid<D>& grid, s
 }
 
 // x ← x + Δt v (the G2P velocity; flip: Σ ψ_i v_i, Transfer::vg) for the particles of block b. Checks that each
-// stays finite and on the grid cut by the boundary planes (else err; a particle past the grid's edge goes to err.left, for the
-// solver's outside policy) and within the cells its block may reach before a re-sort
+// stays finite and on the grid cut by the boundary planes (else err; a particle past the grid's edge goes to
+// err.left, for the solver's outside policy) and within the cells its block may reach before a re-sort
 // (BlockSchedule::reach): drift is set when one left them, so the deterministic colouring stays valid.
 // Raises v2max to the largest ‖v_p‖² (for Δt). A branch-free loop over the arrays; the messages are built
 // only when a particle failed.
