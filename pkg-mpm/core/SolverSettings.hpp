@@ -17,7 +17,8 @@ MPM_CHOICES(OutsidePolicy, "stop|remove|remove-debris")
 // How G2P updates the particle velocity (doc/reference/algorithm.md, "The particle velocity update and C").
 enum class VelocityUpdate : int {
 	Pic  = 0, // Eq. 6 as printed: v_p ← Σ ψ_i v_i (the paper's; default; loses a share of the sub-grid motion every step)
-	Flip = 1  // v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt)
+	Flip = 1  // v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt);
+	          // a damped step (damping > 0) takes Eq. 6: Cundall damping acts on nodal forces, FLIP's sub-grid part is off the grid
 };
 MPM_CHOICES(VelocityUpdate, "pic|flip")
 } // namespace mpm
@@ -36,8 +37,9 @@ MPM_CHOICES(VelocityUpdate, "pic|flip")
 	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
 	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Pic, "-", 0, 1, CC, "", "particle velocity in G2P: 'pic' (default, Eq. 6 as "  \
 	  "printed, v_p = Σ ψ_i v_i: a share of the sub-grid motion lost every step, so results after cracking depend on C) or "   \
-	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step, but nodal damping does not reach the "      \
-	  "particle's own velocity); positions move with Σ ψ_i v_i either way", "Eq. 6", "")                                      \
+	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step); positions move with Σ ψ_i v_i either "  \
+	  "way; a step with damping > 0 takes Eq. 6 under both (nodal damping cannot reach the sub-grid part FLIP keeps)",        \
+	  "Eq. 6", "")                                                                                                             \
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
 	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
 	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \

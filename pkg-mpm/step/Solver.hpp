@@ -173,7 +173,7 @@ public:
 		const ContactStep<D, StepExchange<D>> cs { grid, P, sched, xfer.offs, dt, massFloor, errContact, exchange };
 		const StepInputs<D> in { dt, loadScale(time), damping, massFloor, gravity, contact.active(), grid.hasMirrors(),
 			                     liveViews > 0 || viewTaken,                 // viewWrites: P2G checks what views may have changed
-			                     velocityUpdate == VelocityUpdate::Flip };
+			                     velocityUpdate == VelocityUpdate::Flip && damping == 0 }; // a damped step: Eq. 6 (SolverSettings)
 		if (in.flip)
 			for (auto& c : xfer.vg) c.resize(P.n); // grows only with the particle count
 		if (in.withContact) contact.beforeTransfer(cs);

@@ -29,8 +29,9 @@ SYM_NAMES = {2: ("xx", "yy", "zz", "xy"), 3: ("xx", "yy", "zz", "xy", "xz", "yz"
 FIELDS = {
     "id": ("id", "-", "particle id (add_region's return values)"),
     "pos": ("x", "m", "position, (N, D)"),
-    "vel": ("materialVelocity()", "m/s", "velocity of the material point, (N, D): the particle moves with it; next to a "
-            "body (cut WLS stencil) v_p + C_p (x_p − x̄_p), see 'momentum'"),
+    "vel": ("materialVelocity()", "m/s", "velocity of the material point, (N, D): under velocityUpdate 'pic' the particle moves "
+            "with it, under 'flip' it is the carried v_p (the particle moves with Σ ψ_i v_i); next to a body (cut WLS "
+            "stencil) v_p + C_p (x_p − x̄_p), see 'momentum'"),
     "momentum": ("mass·v", "kg·m/s", "momentum m_p v_p, (N, D): Σ over the particles is the total momentum exactly (the "
                  "grid's); v_p = momentum/mass equals vel except next to a body, where it is the velocity at x̄_p"),
     "stress": ("effectiveStress()", "Pa", "stress carried, damaged for DP–GK (Eq. 40); (N, 4) xx, yy, zz, xy in 2D, "
