@@ -7,6 +7,7 @@ The scene helpers here (_block_on_incline, _rot, _com, _slide, ...) are shared w
 import numpy as np
 import pytest
 import yade_mpm as ym
+from helpers import CentredEnergy
 
 G = 9.81
 ELASTIC = dict(young=2e7, poisson=0.25, density=1000.0)
@@ -129,21 +130,22 @@ def _drop(d, chi=None):
 def test_dropped_block_rebounds_without_energy_gain(d):
     s = _drop(d)
     m = s.view("mass")
-
-    def energy():
-        return s.kineticEnergy() + s.elasticEnergy() + G * (m @ s.view("x1"))
-    e0, y0 = energy(), _com(s, d, "x")[1]
-    emax, ymin, hist = e0, np.inf, []
+    ec = CentredEnergy(s, lambda s: s.elasticEnergy() + G * (m @ s.view("x1")))
+    y0, ymin, hist = _com(s, d, "x")[1], np.inf, []
     while s.time < 0.45:
         s.run(1)
-        emax = max(emax, energy())
+        ec.step()
         ymin = min(ymin, s.view("x1").min())
         hist.append((_com(s, d, "x")[1], _com(s, d, "v")[1]))
     y, vy = np.array(hist).T
     first = np.argmax(vy > 0)                      # first time the block moves up: it hit the wall
     assert first > 0 and y[first] < y0 - 0.08      # it fell ~0.1 m first
     assert y[first:].max() > y[first] + 0.03       # and bounced back up
-    assert emax <= 1.01 * e0
+    # No energy gain on the energy the step conserves (helpers.CentredEnergy; the plain ½ m v² + U swings by +20 % through
+    # the impact at C = 1). It caught the kinematic law's remap correction feeding energy into the impact when it
+    # corrected the normal velocity too: +9.5 % (2D) and +43 % (3D) at C = 1, +4 % at C = 0.9, none at C ≤ 0.7.
+    print(f"d={d} {s.velocityUpdate} C={s.courant}: time-centred energy, largest rise {ec.max_gain():.2e}")
+    assert ec.max_gain() <= 0.01
     assert ymin > 0                                # no particle centre crosses the wall (bounded penetration)
 
 
@@ -157,6 +159,7 @@ def test_reaction_is_minus_the_nodal_contact_forces_every_step(d, law, down, lif
     leaves none: its box starts at the block's top (lift) and moves down faster to stay on the falling block."""
     l = 0.05 if d == 2 else 0.1
     s = ym.make_solver((0, 0, 0)[:d], (1, 1, 0.6)[:d], l)
+    s.courant = 0.5   # the box stays on the block for ≥ 10 of the 60 steps (at C = 1 in 3D: 6)
     ym.add_region(s, ym.ElasticMat(**ELASTIC), (0.2, 0.2, 0.1)[:d], (0.8, 0.5, 0.5)[:d])
     s.gravity = (0.3, -G, 0.2)[:d]
     p = s._addRigidPart()

@@ -100,6 +100,8 @@ def test_two_free_parts_of_one_group_each_take_their_own_response():
     point, f_x/m_i = v0 M_k/(M_k + S_k)/Δt with S_k the mass of box k's contact nodes (per-part sums)."""
     v0, Ms, inf = 0.1, (0.2, 3.0), float("inf")
     s = ym.make_solver((0, 0), (0.4, 0.2), L)
+    s.courant = 0.5   # every node sticks: at C = 1 the node at x = 0.42 m (box 2's end, a small overlap) slips, its
+                      # stick force m v0/Δt then above μ times its penalty force 2 m d/Δt² (measured 0.585 of α v0/Δt)
     ym.add_region(s, ym.ElasticMat(**SLAB), (0.0, 0.0), (0.4, TOP))
     parts = [s._addRigidPart(), s._addRigidPart()]
     g = s._addContactGroup(parts, ym.bodies.contact_params(mu=10.0, cohesion=0.0, chi=0.5, d0=None, law="penalty"))

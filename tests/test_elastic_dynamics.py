@@ -2,7 +2,7 @@
 of free vibration, plane-strain σzz, and 3D plane strain reproducing 2D."""
 import numpy as np
 import yade_mpm as ym
-from helpers import bar_2d, set_velocity, total_momentum
+from helpers import CentredEnergy, bar_2d, set_velocity, total_momentum
 
 
 def test_momentum_conserved_without_boundaries():
@@ -62,15 +62,22 @@ def test_energy_bounded_over_1e4_steps_of_free_vibration():
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.addBoundaryPlane(1, 1, 2 * h, "slip")
     set_velocity(s, lambda x: np.column_stack([0.01 * np.cos(np.pi * x[:, 0] / L), 0 * x[:, 0]]))
-    e0 = s.kineticEnergy() + s.elasticEnergy()
-    e = []
-    for _ in range(100):
-        s.run(100)
-        e.append(s.kineticEnergy() + s.elasticEnergy())
-    e = np.array(e)
+    # measured on the energy the step conserves (helpers.CentredEnergy): the plain KE + U_el at one instant swings by
+    # O(C) of it (max 1.045 ('pic') and 1.053 ('flip') at C = 1 over these steps)
+    e, plain = [], []
+    for k in range(100):
+        if k:
+            s.run(99)
+        ec = CentredEnergy(s, lambda s: s.elasticEnergy())
+        s.run(1)
+        e.append(ec.step())
+        plain.append(s.kineticEnergy() + s.elasticEnergy())
+    e = np.array(e) / e[0]
+    print(f"{s.velocityUpdate} C = {s.courant}: time-centred energy / start: max {e.max():.4f}, min {e.min():.4f}; plain "
+          f"max {max(plain) / plain[0]:.4f}")
     assert np.all(np.isfinite(e))
-    assert e.max() <= 1.03 * e0, e.max() / e0   # bounded: no energy growth
-    assert e.min() >= 0.85 * e0, e.min() / e0   # and not damped away by the transfers
+    assert e.max() <= 1.03, e.max()   # bounded: no energy growth
+    assert e.min() >= 0.85, e.min()   # and not damped away by the transfers
 
 
 def _gravity_block(dim, steps=300):

@@ -26,6 +26,7 @@ s = ym.make_solver((0.0, 0.0), (0.22, 0.36), 0.01, margin=2, distribute=spread) 
 ym.add_region(s, ym.ElasticMat(young=2e9, poisson=0.25, density=2000.0), (0.0, 0.04), (0.2, 0.24))
 s.addBoundaryPlane(0, -1, 0.0, "slip")
 s.gravity, s.damping, s.sortPeriod = (0.0, -9.81), 0.02, 5
+s.courant = 0.5                                # the steps below are counted at it (at C = 1 every migration is before the save)
 x = s.view("x0"); v = s.view("v1"); v[:] = 20.0 + 3.0 * np.sin(np.pi * x / 0.2); del x, v   # drifts across the slab boundary
 s.requestSort()
 rank = ym.parallel.rank()

@@ -29,8 +29,9 @@ def test_case_is_stable(name):
     assert r["max_energy_ratio"] > 0.5, r["max_energy_ratio"]
     # Δt against C·l/(v_c + max‖v‖) recomputed from the particle arrays (not the solver's stableDt)
     assert r["dt_within_limit"] and r["max_dt_over_stable"] <= 1 + 1e-9, r["max_dt_over_stable"]
-    # at C = 0.5 the step stays within the paper's Δt ≤ l/(v_c + |v|) even with the post-step velocities
-    assert r["max_dt_over_paper_limit_after_step"] <= 1.0, r["max_dt_over_paper_limit_after_step"]
+    # against the paper's Δt ≤ l/(v_c + |v|) taken with the post-step velocities, the step exceeds C only by the velocity
+    # gained within it: measured ≤ 1.1 % at C = 1 (overload_step), so ≤ 0.51 at C = 0.5
+    assert r["max_dt_over_paper_limit_after_step"] <= 1.02 * r["courant"], r["max_dt_over_paper_limit_after_step"]
     assert np.all(np.isfinite(h["total"])) and np.all(np.isfinite(h["input"]))
     if r["outcome"] == "stopped_with_error":
         assert r["error_message_clear"], r["message"]
