@@ -65,9 +65,10 @@ public:
 	}
 
 	// After the MUSL remap (Eqs. 16–17), one thread: group gi's nodes' vmusl corrected (Gauss–Seidel, the per-axis
-	// compliance of the solve; bodies and reactions untouched) so each contact's Σ_k rd_k ṽ_k is the velocity the
-	// contact gave its particle: the strain (phase 6) follows the constrained motion. Uncorrected, the remap hands the
-	// strain a field that approaches and slips where the motion did not (doc/reference/contact.md).
+	// compliance of the solve; bodies and reactions untouched) so the tangential part of each contact's Σ_k rd_k ṽ_k is
+	// that of the velocity the contact gave its particle: the strain (phase 6) does not slip where the motion stuck.
+	// The normal part is left to the remap: correcting it too fed energy into an impact at C ≥ 0.8
+	// (doc/reference/contact.md).
 	template <class X>
 	void constrainRemap(size_t gi, const ContactStep<D, X>& s)
 	{
@@ -82,7 +83,8 @@ public:
 			Real worst = 0;
 			for (size_t j = 0; j < kc.size(); ++j) {
 				const auto& c  = kc[j];
-				const Vec   du = remapTarget[j] - particleVelocity(c, t);
+				Vec         du = remapTarget[j] - particleVelocity(c, t);
+				du -= du.dot(c.n) * c.n; // tangential only
 				worst          = std::max(worst, du.norm());
 				for (int k = 0; k < c.nn; ++k) {
 					const size_t  sl  = size_t(c.slot[k]);

@@ -16,8 +16,8 @@ enum class OutsidePolicy : int {
 MPM_CHOICES(OutsidePolicy, "stop|remove|remove-debris")
 // How G2P updates the particle velocity (doc/reference/algorithm.md, "The particle velocity update and C").
 enum class VelocityUpdate : int {
-	Pic  = 0, // Eq. 6 as printed: v_p ← Σ ψ_i v_i (the paper's; default; loses a share of the sub-grid motion every step)
-	Flip = 1  // v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt);
+	Pic  = 0, // Eq. 6 as printed: v_p ← Σ ψ_i v_i (the paper's; loses a share of the sub-grid motion every step)
+	Flip = 1  // default: v_p ← v_p + Σ ψ_i (v_i − v_i^old), positions moved with Σ ψ_i v_i (as the reference code Graphyt);
 	          // a damped step (damping > 0) takes Eq. 6: Cundall damping acts on nodal forces, FLIP's sub-grid part is off the grid
 };
 MPM_CHOICES(VelocityUpdate, "pic|flip")
@@ -27,7 +27,7 @@ MPM_CHOICES(VelocityUpdate, "pic|flip")
 #define MPM_SOLVER_SETTINGS(X)                                                                                                    \
 	X(Vec, gravity, 0, "m/s²", -INFINITY, INFINITY, OO, "g", "gravitational acceleration", "Eq. 22", "")                        \
 	X(Real, damping, 0, "-", 0, 1, CO, "α", "Cundall local damping of the nodal forces, f ← f − α|f|sign(v)", "", "")           \
-	X(Real, courant, 0.5, "-", 0, 1, OC, "C", "Courant number of the automatic step Δt = C·l/(v_c + max‖v‖)", "Sec. 2.5", "")    \
+	X(Real, courant, 1.0, "-", 0, 1, OC, "C", "Courant number of the automatic step Δt = C·l/(v_c + max‖v‖)", "Sec. 2.5", "")    \
 	X(bool, autoDt, true, "-", 0, 1, CC, "", "recompute Δt every step from the stability condition (else fixedDt)", "", "")     \
 	X(Real, fixedDt, 0, "s", 0, INFINITY, CO, "Δt", "time step used when autoDt is off (0 = not set; must be > 0 then)", "", "") \
 	X(Real, tractionRampTime, 0, "s", 0, INFINITY, CO, "", "particle surface forces ramp linearly from 0 over this time; 0 = at once", \
@@ -35,11 +35,11 @@ MPM_CHOICES(VelocityUpdate, "pic|flip")
 	X(int, sortPeriod, 50, "steps", 1, 1e9, CC, "", "re-sort particles by block at least every this many steps", "", "")        \
 	X(Real, mpiRebalance, 1.1, "-", 1, INFINITY, CC, "", "MPI only: at each re-sort, cut the slabs again when the busiest rank holds more " \
 	  "than this × the mean particle count (inf = never; doc/scaling.md)", "", "")                                             \
-	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Pic, "-", 0, 1, CC, "", "particle velocity in G2P: 'pic' (default, Eq. 6 as "  \
-	  "printed, v_p = Σ ψ_i v_i: a share of the sub-grid motion lost every step, so results after cracking depend on C) or "   \
-	  "'flip' (v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step); positions move with Σ ψ_i v_i either "  \
-	  "way; a step with damping > 0 takes Eq. 6 under both (nodal damping cannot reach the sub-grid part FLIP keeps)",        \
-	  "Eq. 6", "")                                                                                                             \
+	X(VelocityUpdate, velocityUpdate, VelocityUpdate::Flip, "-", 0, 1, CC, "", "particle velocity in G2P: 'flip' (default, "   \
+	  "v_p += Σ ψ_i Δv_i, as the reference code Graphyt: no loss per step, so results after cracking hardly depend on C) " \
+	  "or 'pic' (Eq. 6 as printed, the paper's: v_p = Σ ψ_i v_i loses a share of the sub-grid motion every step, so "       \
+	  "results after cracking depend on C); positions move with Σ ψ_i v_i either way; a step with damping > 0 takes Eq. 6 " \
+	  "under both (nodal damping cannot reach the sub-grid part FLIP keeps)", "Eq. 6", "")                                  \
 	X(bool, trackEnergy, false, "-", 0, 1, CC, "", "accumulate the external work (one extra pass per step)", "", "")             \
 	X(OutsidePolicy, outside, OutsidePolicy::RemoveDebris, "-", 0, 2, CC, "", "particles that leave the grid: 'stop' the run, "  \
 	  "'remove' them, or 'remove-debris' (D = 1 or detached material removed, the body reaching the edge stops the run); "   \

@@ -66,11 +66,13 @@ def run_one(a, name):
     s, b, disp, stress = build(a, v)
     if "courant" in v:                        # else the solver's default C
         s.courant = v["courant"]
+    if "velocity_update" in v:                # else the solver's default
+        s.velocityUpdate = v["velocity_update"]
     x0 = ym.get(s, "pos")
     lat = analysis.Lattice(x0, s.spacing / 2, origin=(0, 0))
     soft_end = analysis.softening_end(s)
     curve, res = [], dict(scene=a.scene, case=a.case, variant=name, label=v["label"], spacing_m=a.spacing, end_time_s=a.end_time,
-                          courant=s.courant, particles=int(s.numParticles), snapshots={}, first_crack=None)
+                          courant=s.courant, velocity_update=s.velocityUpdate, particles=int(s.numParticles), snapshots={}, first_crack=None)
     fl = b["flaw"]
     times = fidelity.CrackTimes(lat, fl["toe"], fl["tip"], soft_end, 2 * s.spacing) if a.scene == "uniaxial" and fl else None
 
