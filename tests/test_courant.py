@@ -28,6 +28,18 @@ def test_check_courant_names_the_option_and_range(bad):
         ym.scene.check_courant(bad)
 
 
+def test_velocity_update_choices_read_from_the_declaration():
+    """--velocity-update's choices are the declared words of Solver.velocityUpdate (settingsTable), not a second list."""
+    s = ym.make_solver((0.0, 0.0), (1.0, 1.0), 0.1)
+    row = next(p for p in s.settingsTable() if p["name"] == "velocityUpdate")
+    assert ym.scene.setting_choices("velocityUpdate") == tuple(row["choices"]) == ("pic", "flip")
+    assert row["default"] == s.velocityUpdate
+    for w in ym.scene.setting_choices("velocityUpdate"):
+        s.velocityUpdate = w                      # every listed word is accepted
+    with pytest.raises(ValueError, match="'courant' is not a choice setting"):
+        ym.scene.setting_choices("courant")
+
+
 def test_unknown_setting_named():
     with pytest.raises(ValueError, match="unknown solver setting 'courantt'"):
         ym.scene.setting_default("courantt")

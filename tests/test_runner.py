@@ -179,3 +179,23 @@ def test_solver_error_propagates_or_returns_with_its_message():
         runner.run(s, max_steps=1, on_error="ignore")
     s, _ = sc.case_grid_edge(True)
     assert runner.run(s, max_steps=1).error is None
+
+
+def test_progress_line_reports_the_step_and_flags_a_fallen_one():
+    """The progress line shows the last Δt; one below Progress.DT_DROP of the largest seen is flagged (a run that slows
+    by that factor says why it may, doc/validation/stability.md)."""
+    import io
+    s, _ = block()
+    s.run(3)
+    out = io.StringIO()
+    prog = ym.progress.Progress(1.0, "p", interval=0.0, stream=out)
+    prog.update(s.steps, s.time, force=True, solver=s)
+    dt = s.lastDt
+    assert f"Δt {dt:.3g} s" in out.getvalue() and "expanding" not in out.getvalue()
+
+    class Fallen:                                   # the same solver's account, a step 10× below the largest seen
+        lastDt = dt / 10
+        _removedAccount = staticmethod(s._removedAccount)
+    prog.update(s.steps, s.time, force=True, solver=Fallen())
+    last = out.getvalue().splitlines()[-1]
+    assert f"Δt {dt / 10:.3g} s (1/10 of the largest" in last, last

@@ -168,11 +168,16 @@ struct StateWrap {
 		return d;
 	}
 
+	// The settings' declarations (name, unit, range or choices, default, doc), as the materials' paramTable().
+	static bp::list settingsTable(const S&) { return ParamBinding<S>::table(); }
+
 	static void expose(SolverClass<D>& cls, const char* name)
 	{
 		ParamBinding<S>::exposeProperties(cls); // settings and writable state, checked (SolverSettings.hpp)
 		cls.def("settings", &settings, "The settings (SolverSettings.hpp) as a dict {name: value}.")
 		        .def("setSettings", &setSettings, bp::arg("settings"), "Write settings from a dict (all or nothing; unknown names refused).")
+		        .def("settingsTable", &settingsTable, "The settings' declarations (SolverSettings.hpp): a list of dicts with name, unit, "
+		                                              "range (lo, hi) or choices, default, doc and equation.")
 		        .def("_phaseTimes", &phaseTimes)
 		        .def("_resetPhaseTimes", &resetPhaseTimes)
 		        .def("_getResumeState", &getResumeState)

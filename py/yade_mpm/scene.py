@@ -55,13 +55,23 @@ def setting_default(name):
     return getattr(probe, name)
 
 
+def setting_choices(name):
+    """The words a choice setting accepts (e.g. velocityUpdate), read from its declaration."""
+    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+    row = next((p for p in probe.settingsTable() if p["name"] == name), None)
+    if row is None or "choices" not in row:
+        raise ValueError(f"'{name}' is not a choice setting; choice settings: "
+                         f"{', '.join(p['name'] for p in probe.settingsTable() if 'choices' in p)}")
+    return tuple(row["choices"])
+
+
 def courant_option(ap):
     """Adds --courant and --velocity-update to a script's argparse parser: default None = the solver's declared
     value (read, not repeated); a C is checked against the declared range by :func:`check_courant`; both are
     set on a solver by :func:`apply_step_options`."""
     ap.add_argument("--courant", type=float, default=None,
                     help=f"Courant number C of the step Δt = C·l/(v_c + max|v|) (default: the solver's, {setting_default('courant'):g})")
-    ap.add_argument("--velocity-update", choices=("pic", "flip"), default=None,
+    ap.add_argument("--velocity-update", choices=setting_choices("velocityUpdate"), default=None,
                     help=f"particle velocity update in G2P: 'pic' (Eq. 6 as printed, the paper's) or 'flip' (default: the "
                          f"solver's, {setting_default('velocityUpdate')})")
 

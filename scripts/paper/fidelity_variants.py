@@ -54,9 +54,10 @@ def build(a, v):
     if a.scene == "tunnel":
         s, b = cases.arch_tunnel(a.case, a.spacing, material=rocks.pan2020_sandstone(**mat), floor=v.get("floor", cases.TUNNEL_FLOOR),
                                  flaw_angle=math.radians(v.get("flaw_angle", cases.FLAW_ANGLE_DEG)), flaw_toe_gap=v.get("flaw_toe_gap", cases.FLAW_TOE_GAP),
-                                 flaw_toe_height=v.get("flaw_toe_height", cases.FLAW_TOE_HEIGHT))
+                                 flaw_toe_height=v.get("flaw_toe_height", cases.FLAW_TOE_HEIGHT), contact_law=v.get("contact_law"))
         return s, b, b["platen_displacement"], b["axial_stress"]
-    s, b = cases.uniaxial_flaw(a.case, a.spacing, mu_con=a.mu_con if a.case == "filled" else 0.0, material=rocks.miao2018_sandstone(**mat))
+    s, b = cases.uniaxial_flaw(a.case, a.spacing, mu_con=a.mu_con if a.case == "filled" else 0.0, material=rocks.miao2018_sandstone(**mat),
+                               contact_law=v.get("contact_law"))
     return s, b, lambda: b["axial_strain"]() * b["height"], b["axial_stress"]
 
 
@@ -72,7 +73,8 @@ def run_one(a, name):
     lat = analysis.Lattice(x0, s.spacing / 2, origin=(0, 0))
     soft_end = analysis.softening_end(s)
     curve, res = [], dict(scene=a.scene, case=a.case, variant=name, label=v["label"], spacing_m=a.spacing, end_time_s=a.end_time,
-                          courant=s.courant, velocity_update=s.velocityUpdate, particles=int(s.numParticles), snapshots={}, first_crack=None)
+                          courant=s.courant, velocity_update=s.velocityUpdate, contact_law=v.get("contact_law", "default"),
+                          particles=int(s.numParticles), snapshots={}, first_crack=None)
     fl = b["flaw"]
     times = fidelity.CrackTimes(lat, fl["toe"], fl["tip"], soft_end, 2 * s.spacing) if a.scene == "uniaxial" and fl else None
 

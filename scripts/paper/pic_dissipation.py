@@ -19,6 +19,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "py"))
 import yade_mpm as ym  # noqa: E402
 from yade_mpm import rocks  # noqa: E402
+from yade_mpm.scene import check_courant, setting_choices  # noqa: E402
 
 
 def energy_left(courant, wavelength_cells, t_end, l=2e-3, amplitude=0.1, velocity_update="pic"):
@@ -53,18 +54,24 @@ def main():
     ap.add_argument("--courant", default="1,0.5,0.25,0.125", help="comma-separated Courant numbers")
     ap.add_argument("--wavelengths", default="25,8", help="comma-separated wavelengths [cells]")
     ap.add_argument("--time", type=float, default=100e-6, help="simulated time [s] (default 100 µs)")
-    ap.add_argument("--velocity-update", default="pic,flip", help="comma-separated velocity updates (pic, flip)")
+    ap.add_argument("--velocity-update", default=",".join(setting_choices("velocityUpdate")),
+                    help="comma-separated velocity updates (default: every choice of Solver.velocityUpdate)")
     a = ap.parse_args()
     try:
         cs = [float(c) for c in a.courant.split(",")]
         ws = [float(w) for w in a.wavelengths.split(",")]
     except ValueError:
         ap.error("--courant and --wavelengths take comma-separated numbers")
-    if not all(0 < c <= 1 for c in cs) or not all(w >= 2 for w in ws) or not a.time > 0:
-        ap.error("--courant in (0, 1], --wavelengths ≥ 2 cells, --time > 0")
+    try:
+        cs = [check_courant(c) for c in cs]     # the solver's declared range
+    except ValueError as e:
+        ap.error(str(e))
+    if not all(w >= 2 for w in ws) or not a.time > 0:
+        ap.error("--wavelengths ≥ 2 cells, --time > 0")
     us = a.velocity_update.split(",")
-    if not all(u in ("pic", "flip") for u in us):
-        ap.error(f"--velocity-update = {a.velocity_update!r}: comma-separated pic, flip")
+    allowed = setting_choices("velocityUpdate")
+    if not all(u in allowed for u in us):
+        ap.error(f"--velocity-update = {a.velocity_update!r}: comma-separated, each one of {', '.join(allowed)}")
     os.makedirs(a.out, exist_ok=True)
     path = os.path.join(a.out, "pic_dissipation.csv")
     with open(path, "w", newline="") as f:
