@@ -14,7 +14,7 @@ TOPICS = {
              "test_uncertainty", "test_threads"],
     "physics": ["test_boundaries", "test_contact", "test_contact_yade", "test_contact_corners", "test_contact_initial_d0",
                 "test_contact_kinematic", "test_contact_matrix", "test_contact_stick", "test_courant", "test_damage_threshold",
-                "test_determinism", "test_dpgk", "test_dpgk_damage", "test_elastic_dynamics", "test_multimaterial", "test_outside",
+                "test_determinism", "test_dpgk", "test_dpgk_damage", "test_failed_bulking", "test_elastic_dynamics", "test_multimaterial", "test_outside",
                 "test_checkpoint", "test_hybrid", "test_yade_hook", "test_examples", "test_pic_dissipation"],
     "paper": ["test_bonded", "test_filled_flaw_fem", "test_case_results", "test_circular_opening", "test_fidelity", "test_penny_crack", "test_penny_prism",
               "test_report", "test_scripts_smoke", "test_slab3d", "test_stability", "test_studies", "test_tunnel", "test_tunnel_script"],

@@ -272,6 +272,11 @@ struct DruckerPragerGradyKipp {
 		else updatePoint(s, de, P.epsP[p], P.damage[p], P.eps0[p], dt); // vol0 and id are read only by the flaw population
 	}
 	Sym<D> forceStress(const Particles<D>& P, size_t p) const { return damaged(P.stress(p), P.damage[p]); }
+	// Largest volume of particle p [m³]: failedBulking × V₀ once it has failed (D = 1), else none.
+	Real volumeLimit(const Particles<D>& P, size_t p) const
+	{
+		return mat.damage && P.damage[p] >= 1 ? mat.failedBulking * P.vol0[p] : INFINITY;
+	}
 };
 
 } // namespace mpm

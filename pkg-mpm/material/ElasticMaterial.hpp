@@ -35,6 +35,7 @@ struct LinearElastic {
 	void update(Particles<D>&, size_t, Sym<D>& s, const Sym<D>& de, Real) const { elasticTrial(s, de, K, G); }
 	// Stress the particle exerts on the grid (Eq. 21).
 	Sym<D> forceStress(const Particles<D>& P, size_t p) const { return P.stress(p); }
+	static constexpr Real volumeLimit(const Particles<D>&, size_t) { return INFINITY; } // no failure: no limit
 };
 
 } // namespace mpm

@@ -79,4 +79,9 @@ MPM_CHOICES(PlasticStrainIncrement, "reference-code|von-mises")
 	  "Benz–Asphaug flaws per particle (Weibull thresholds from k, m; D ≤ activated fraction); 0 = one threshold (Eq. 37)",    \
 	  "Eqs. 37–38", "damage")                                                                                                    \
 	X(int, flawSeed, 0, "-", 0, 2147483647, CC, "", "seed of the flaw population (thresholds depend on seed and particle id)",  \
-	  "Eq. 37", "damage")
+	  "Eq. 37", "damage")                                                                                                        \
+	X(Real, failedBulking, 1.5, "-", 1, INFINITY, CC, "J_max",                                                                  \
+	  "largest volume of a failed particle (D = 1) over its initial one, as the bulking factor of broken rock (1.3–1.6 in "      \
+	  "rock engineering); beyond it the opening is void between particles, not material; inf = no limit (the paper's: a lone "  \
+	  "failed fragment keeps its expansion rate, grows without bound and drives Δt towards 0, doc/validation/stability.md)",    \
+	  "", "damage")

@@ -31,6 +31,11 @@ struct MixedMaterial {
 		const uint8_t m = P.mat[p];
 		return kind[m] == uint8_t(MaterialKind::Elastic) ? el[slot[m]].forceStress(P, p) : dp[slot[m]].forceStress(P, p);
 	}
+	Real volumeLimit(const Particles<D>& P, size_t p) const
+	{
+		const uint8_t m = P.mat[p];
+		return kind[m] == uint8_t(MaterialKind::Elastic) ? INFINITY : dp[slot[m]].volumeLimit(P, p);
+	}
 };
 
 // Density measure whose minimum sets the time step: v_c = √(M / min dtDensity) for a single material

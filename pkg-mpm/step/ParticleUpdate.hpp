@@ -49,7 +49,7 @@ inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Rea
 			mat.update(P, p, s, de, dt); // Eqs. 27–40
 			P.setStress(p, s);
 			const Real J = jacobian(L, dt);
-			P.vol[p] *= J;
+			P.vol[p] = std::min(P.vol[p] * J, mat.volumeLimit(P, p)); // a failed particle bulks at most to failedBulking × V₀
 			Real check = J; // one sum carries every value that must be finite (NaN/inf propagate)
 			for (int k = 0; k < Dim<D>::nSym; ++k) check += s.c[k];
 			if (!(std::isfinite(check) && J > 0)) {

@@ -109,6 +109,8 @@ VARIANTS = {
     "penalty": dict(contact_law="penalty", label="Eq. 23 as printed: the penalty contact κ = 2m/Δt² (the paper's) instead of the kinematic law"),
     "penalty_courant_0.25": dict(contact_law="penalty", courant=0.25, label="Eq. 23 at C = 0.25 (with C = 0.125: its Δt → 0 limit by Richardson in Δt²)"),
     "penalty_courant_0.125": dict(contact_law="penalty", courant=0.125, label="Eq. 23 at C = 0.125"),
+    "no_failed_bulking": dict(material=dict(failedBulking=float("inf")),
+                              label="failed particles bulk without limit (the paper) instead of at most 1.5 × V₀"),
     "pic": dict(velocity_update="pic", label="Eq. 6 as printed, v_p = Σ ψ_i v_i (the paper's particle velocity) instead of FLIP"),
     "principal_strain": dict(material=dict(damageStrain="principal"), label="Eq. 36: maximum principal strain instead of σ̃max/(K+4G/3)"),
     "as_printed_growth": dict(material=dict(growthLaw="as-printed"), label="Eq. 38 as printed (dD^⅓/dt ∝ ε̄^⅓)"),
