@@ -34,7 +34,7 @@ struct MixedMaterial {
 	Real volumeLimit(const Particles<D>& P, size_t p) const
 	{
 		const uint8_t m = P.mat[p];
-		return kind[m] == uint8_t(MaterialKind::Elastic) ? INFINITY : dp[slot[m]].volumeLimit(P, p);
+		return kind[m] == uint8_t(MaterialKind::Elastic) ? el[slot[m]].volumeLimit(P, p) : dp[slot[m]].volumeLimit(P, p);
 	}
 };
 

@@ -32,11 +32,16 @@ def make_solver(lo, hi, spacing, margin=2, shift=None, distribute=False):
     return cls(tuple(origin), float(spacing), tuple(int(c) for c in cells), distribute=bool(distribute))
 
 
+def _settings_probe():
+    """A one-cell solver whose settings hold the declared defaults (read by the setting helpers below)."""
+    return _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+
+
 def check_setting(name, value, option=None):
     """Checks a solver setting (declared once in pkg-mpm/core/SolverSettings.hpp) before any solver exists,
     e.g. a command-line option; the ValueError names `option` (default: the setting) with the declared
     unit and range. Returns the value."""
-    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+    probe = _settings_probe()
     if name not in probe.settings():
         raise ValueError(f"unknown solver setting '{name}'; known: {', '.join(probe.settings())}")
     try:
@@ -49,7 +54,7 @@ def check_setting(name, value, option=None):
 def setting_default(name):
     """The declared default of a solver setting (pkg-mpm/core/SolverSettings.hpp), e.g. for a script option
     whose default is the solver's: read here, never repeated."""
-    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
+    probe = _settings_probe()
     if name not in probe.settings():
         raise ValueError(f"unknown solver setting '{name}'; known: {', '.join(probe.settings())}")
     return getattr(probe, name)
@@ -57,12 +62,11 @@ def setting_default(name):
 
 def setting_choices(name):
     """The words a choice setting accepts (e.g. velocityUpdate), read from its declaration."""
-    probe = _core.Solver2D((0.0, 0.0), 1.0, (1, 1))
-    row = next((p for p in probe.settingsTable() if p["name"] == name), None)
-    if row is None or "choices" not in row:
-        raise ValueError(f"'{name}' is not a choice setting; choice settings: "
-                         f"{', '.join(p['name'] for p in probe.settingsTable() if 'choices' in p)}")
-    return tuple(row["choices"])
+    probe = _settings_probe()
+    choices = {p["name"]: tuple(p["choices"]) for p in probe.settingsTable() if "choices" in p}
+    if name not in choices:
+        raise ValueError(f"'{name}' is not a choice setting; choice settings: {', '.join(choices)}")
+    return choices[name]
 
 
 def courant_option(ap):

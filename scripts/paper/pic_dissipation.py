@@ -54,7 +54,8 @@ def main():
     ap.add_argument("--courant", default="1,0.5,0.25,0.125", help="comma-separated Courant numbers")
     ap.add_argument("--wavelengths", default="25,8", help="comma-separated wavelengths [cells]")
     ap.add_argument("--time", type=float, default=100e-6, help="simulated time [s] (default 100 µs)")
-    ap.add_argument("--velocity-update", default=",".join(setting_choices("velocityUpdate")),
+    allowed = setting_choices("velocityUpdate")
+    ap.add_argument("--velocity-update", default=",".join(allowed),
                     help="comma-separated velocity updates (default: every choice of Solver.velocityUpdate)")
     a = ap.parse_args()
     try:
@@ -69,7 +70,6 @@ def main():
     if not all(w >= 2 for w in ws) or not a.time > 0:
         ap.error("--wavelengths ≥ 2 cells, --time > 0")
     us = a.velocity_update.split(",")
-    allowed = setting_choices("velocityUpdate")
     if not all(u in allowed for u in us):
         ap.error(f"--velocity-update = {a.velocity_update!r}: comma-separated, each one of {', '.join(allowed)}")
     os.makedirs(a.out, exist_ok=True)
