@@ -45,11 +45,13 @@ def test_cohesion_holds_at_capacity_and_gives_way_below(kinematic):
 
 def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     """Elastic column 0.05 × 0.1 m on a slip base, free sides, pressed 0.1 mm by a frictionless rigid platen and
-    held (damping 0.5, 0.06 s): (platen force / width over platen travel / height) / E/(1 − ν²), and how far the
-    top particle's face lies beyond the platen's [cells]."""
+    held (damping 0.5, 0.06 s): (platen force / width over platen travel / height) / E/(1 − ν²), how far the
+    top particle's face lies beyond the platen's [cells], and (platen force / width over the specimen's own strain
+    −du_y/dy, fitted over the particles of its middle 60 %) / E/(1 − ν²)."""
     W, H, v = 0.05, 0.1, 0.05
     s = ym.make_solver((-0.03, 0), (W + 0.06, H + 0.02), l)
     ym.add_region(s, ym.ElasticMat(young=E, poisson=nu, density=1000.0), (0, 0), (W, H), ppc=ppc)
+    y0 = s.view("x1")[np.argsort(s.view("id"), kind="stable")].copy()
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping, s.courant = 0.5, courant
     p = s._addRigidPart()
@@ -66,7 +68,11 @@ def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     y = s.view("x1")
     top = np.argmax(y)
     overlap = (y[top] + 0.5 * np.sqrt(s.view("vol")[top]) - face) / l
-    return (s._rigidPartForce(p)[1] / W) / ((H - face) / H) / (E / (1 - nu ** 2)), overlap
+    sigma, M = s._rigidPartForce(p)[1] / W, E / (1 - nu ** 2)
+    u = y[np.argsort(s.view("id"), kind="stable")] - y0
+    mid = (y0 > 0.2 * H) & (y0 < 0.8 * H)
+    own = sigma / -np.polyfit(y0[mid], u[mid], 1)[0] / M
+    return sigma / ((H - face) / H) / M, overlap, own
 
 
 def test_elastic_platen_modulus_is_independent_of_the_time_step_and_the_limit_of_eq23():
@@ -74,15 +80,18 @@ def test_elastic_platen_modulus_is_independent_of_the_time_step_and_the_limit_of
     platen's face where the particles' faces are (< 1e-3 cell), and it is Eq. 23's Δt → 0 limit: the penalty law at
     C = 0.25 and 0.125 extrapolated in Δt² (Richardson) lies within 0.5 % (measured: kinematic 1.0163 / 1.0168 /
     1.0149, penalty 1.0031 / 1.0116 → 1.0145; penalty at C = 0.5: 0.9705, its soft contact layer).
-    The modulus itself is 1.6 % above E/(1 − ν²) on this 10-cell column: a discretisation error of the grid and the
-    particle layer under the platen, not of the contact (1.0128 on a 40-cell column)."""
+    From the specimen's own strain (its middle 60 %) the modulus is E/(1 − ν²) within 0.5 % at every C (measured
+    0.9988). Over the platen's travel it is 1.6 % above: the particle rows next to the platen carry a boundary layer
+    (a strain that alternates cell by cell, decaying over ~5 cells below the platen) whose size depends on where the
+    grid cuts the top face (1.0487 with the face on a half-node line); Eq. 23's limit has it too."""
     kin = {C: _platen_modulus("kinematic", C) for C in (1.0, 0.5, 0.25)}
-    vals = np.array([m for m, _ in kin.values()])
+    vals = np.array([m for m, _, _ in kin.values()])
     assert np.ptp(vals) / vals.mean() < 0.003
-    assert max(abs(o) for _, o in kin.values()) < 1e-3
+    assert max(abs(o) for _, o, _ in kin.values()) < 1e-3
     assert abs(vals.mean() - 1) < 0.02
-    p4, _ = _platen_modulus("penalty", 0.25)
-    p8, _ = _platen_modulus("penalty", 0.125)
+    assert max(abs(own - 1) for _, _, own in kin.values()) < 0.005
+    p4 = _platen_modulus("penalty", 0.25)[0]
+    p8 = _platen_modulus("penalty", 0.125)[0]
     limit = p8 + (p8 - p4) / 3                       # error ∝ Δt²: halving Δt removes 3/4 of it
     assert abs(vals.mean() / limit - 1) < 0.005
     assert _platen_modulus("penalty", 0.5)[0] < vals.mean() - 0.03   # Eq. 23 at the old default: a soft layer

@@ -2,7 +2,7 @@
 the cause analysis of the fidelity table (issue 18, doc/validation/report.md): each run writes
 OUT/<scene>_<case>_<variant>.json with what the rows need, and report.py builds the matrix choice × row.
 
-    /usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial --case open --variants baseline,courant_1
+    /usr/bin/python3 scripts/paper/fidelity_variants.py --scene uniaxial --case open --variants baseline,courant_0.25
     /usr/bin/python3 scripts/paper/fidelity_variants.py --scene tunnel --case filled_flaw --spacing 0.0025 --end-time 0.02
 
 Screening runs: a coarse grid and a short loading are allowed (the JSON records both); compare variants

@@ -103,7 +103,6 @@ def near_segment_stress(x0, smax, a, b, width):
 VARIANTS = {
     "baseline": dict(label="defaults (C and the velocity update the solver's, Eq. 36 as printed, Benz–Asphaug growth, V = particle, c_r = 0.1, ε̄p,crit = 0.1, "
                                 "Δε̄p = k̄φ Δλ)"),
-    "courant_1": dict(courant=1.0, label="Δt at the paper's bound, C = 1"),
     "courant_0.5": dict(courant=0.5, label="Δt at half the paper's bound, C = 0.5"),
     "courant_0.25": dict(courant=0.25, label="Δt at a quarter of the paper's bound, C = 0.25 (a converged reference for Δt)"),
     "penalty": dict(contact_law="penalty", label="Eq. 23 as printed: the penalty contact κ = 2m/Δt² (the paper's) instead of the kinematic law"),
