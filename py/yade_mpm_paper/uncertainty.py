@@ -17,7 +17,7 @@ import numpy as np
 # base (y = 0: fy ∈ {0, ½}) with free sides (any fx); the tunnel has slip walls left, right and below (fx, fy ∈ {0, ½}).
 SHIFTS = {
     "uniaxial": ((0.0, 0.0), (0.2, 0.0), (0.4, 0.5), (0.6, 0.0), (0.8, 0.5)),
-    "tunnel": ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)),
+    "tunnel": ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)),   # and the grids of 74 and 76 cells across (scripts/paper/tunnel_shifts.table)
 }
 
 
