@@ -49,6 +49,8 @@ def test_observed_order_and_richardson():
     assert r["monotone"] and r["order"] == pytest.approx(1.5) and r["limit"] == pytest.approx(1.0, rel=1e-12)
     assert U.richardson(h, [1.0, 1.2, 1.1])["limit"] is None     # not monotone: no extrapolation
     assert U.richardson(h, [53.05, 52.88, 52.54])["limit"] is None   # monotone but the changes grow: not converging
+    slow = U.richardson(h, [53.017, 52.775, 52.54])                     # the changes barely shrink: order 0.04
+    assert slow["order"] == pytest.approx(0.042, abs=0.01) and slow["limit"] is None
     with pytest.raises(ValueError, match="constant ratio"):
         U.richardson([0.04, 0.02, 0.015], q)
 
