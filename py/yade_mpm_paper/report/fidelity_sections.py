@@ -46,12 +46,13 @@ def fidelity_section(R):
     R.w("| figure | the paper's claim | measured, default grid | verdict | measured, paper grid | verdict |", "|---|---|---|---|---|---|")
     for r in rows:
         R.w(f"| {r['fig']} | {r['claim']} | {r['default']} | **{r['verdict']}** | {r['paper_grid']} | {r['verdict_paper']} |")
+    kind = lambda v: v.split(":")[0].split(" (")[0]          # "within uncertainty (agrees 4, partly 1 of 5)": one kind
     n = {}
     for r in rows:
-        n[r["verdict"].split(":")[0]] = n.get(r["verdict"].split(":")[0], 0) + 1
+        n[kind(r["verdict"])] = n.get(kind(r["verdict"]), 0) + 1
     npg = {}
     for r in rows:
-        k = r["verdict_paper"].split(":")[0]
+        k = kind(r["verdict_paper"])
         if k not in ("—", "not run"):
             npg[k] = npg.get(k, 0) + 1
     R.w("", "Default grid: " + ", ".join(f"{v} {k}" for k, v in sorted(n.items())) + f" of {len(rows)} rows."
