@@ -6,7 +6,7 @@ import json
 import os
 
 from .. import uncertainty
-from .document import shown
+from .document import include_notes, shown
 
 ENSEMBLES = {"uniaxial": ("ensemble/uniaxial", "scripts/paper/uniaxial_shifts.table", "scripts/paper/uniaxial_flaw.py"),
              "tunnel": ("ensemble/tunnel", "scripts/paper/tunnel_shifts.table", "scripts/paper/tunnel_spalling.py")}
@@ -32,11 +32,13 @@ def convergence_section(R):
         R.w(f"*Not run here* — `/usr/bin/python3 scripts/paper/convergence.py --out {shown(d)}` writes `{shown(d)}/`.", "")
         return
     s = json.load(open(path))
-    R.w(f"Each case at three grid spacings (each half the last) and two Courant numbers, every run in its own one-thread process "
+    R.w(f"Each case at three grid spacings (the elastic tunnel at four; each half the last) and two Courant numbers, every run in its own one-thread process "
         f"(`/usr/bin/python3 scripts/paper/convergence.py --out {shown(d)}`). The cost is the run's CPU time (on an idle host its wall "
         "time with one thread; the wall times are in the table) and its particle-steps. The error is against the analytic solution "
         "where there is one (Kirsch, Sneddon, the plane-strain modulus E/(1 − ν²)), otherwise against the Richardson limit of the "
-        "three grids (`yade_mpm_paper.uncertainty.richardson`, only for a monotone sequence; the finest run then has no error of its own).", "")
+        "last three grids (`yade_mpm_paper.uncertainty.richardson`, only for a monotone sequence whose changes shrink with an observed "
+        "order ≥ 0.5), else against the finest run; the run the error is taken against has no error of its own.", "")
+    include_notes(R, os.path.join(d, "notes.md"))
     R.figure(os.path.join(d, "error_vs_time.png"), "error_vs_time.png", "error against the run's CPU time, one line per refinement path")
     R.w(open(os.path.join(d, "table.md")).read().rstrip(), "")
     lines = []
