@@ -51,7 +51,7 @@ def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     W, H, v = 0.05, 0.1, 0.05
     s = ym.make_solver((-0.03, 0), (W + 0.06, H + 0.02), l)
     ym.add_region(s, ym.ElasticMat(young=E, poisson=nu, density=1000.0), (0, 0), (W, H), ppc=ppc)
-    y0 = s.view("x1")[np.argsort(s.view("id"), kind="stable")].copy()
+    y0 = ym.get(s, "pos")[:, 1]                      # id order
     s.addBoundaryPlane(1, -1, 0.0, "slip")
     s.damping, s.courant = 0.5, courant
     p = s._addRigidPart()
@@ -69,7 +69,7 @@ def _platen_modulus(law, courant, l=0.01, ppc=2, E=2e7, nu=0.25):
     top = np.argmax(y)
     overlap = (y[top] + 0.5 * np.sqrt(s.view("vol")[top]) - face) / l
     sigma, M = s._rigidPartForce(p)[1] / W, E / (1 - nu ** 2)
-    u = y[np.argsort(s.view("id"), kind="stable")] - y0
+    u = ym.get(s, "pos")[:, 1] - y0
     mid = (y0 > 0.2 * H) & (y0 < 0.8 * H)
     own = sigma / -np.polyfit(y0[mid], u[mid], 1)[0] / M
     return sigma / ((H - face) / H) / M, overlap, own

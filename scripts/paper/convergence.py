@@ -1,5 +1,5 @@
-"""Error against run time for the reference cases: each case at three grid spacings (each half the last) and
-two Courant numbers, every run in its own one-thread process, with its wall time, CPU time and particle-steps.
+"""Error against run time for the reference cases: each case at three or more grid spacings (each half the
+last) and two Courant numbers, every run in its own one-thread process, with its wall time, CPU time and particle-steps.
 
     /usr/bin/python3 scripts/paper/convergence.py --out out/convergence                  # the default families (~1.5 h)
     /usr/bin/python3 scripts/paper/convergence.py --out out/convergence --families kirsch,sneddon

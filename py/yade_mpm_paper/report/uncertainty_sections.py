@@ -32,7 +32,7 @@ def convergence_section(R):
         R.w(f"*Not run here* — `/usr/bin/python3 scripts/paper/convergence.py --out {shown(d)}` writes `{shown(d)}/`.", "")
         return
     s = json.load(open(path))
-    R.w(f"Each case at three grid spacings (the elastic tunnel at four; each half the last) and two Courant numbers, every run in its own one-thread process "
+    R.w(f"Each case at three or more grid spacings (each half the last; the table lists them) and two Courant numbers, every run in its own one-thread process "
         f"(`/usr/bin/python3 scripts/paper/convergence.py --out {shown(d)}`). The cost is the run's CPU time (on an idle host its wall "
         "time with one thread; the wall times are in the table) and its particle-steps. The error is against the analytic solution "
         "where there is one (Kirsch, Sneddon, the plane-strain modulus E/(1 − ν²)), otherwise against the Richardson limit of the "
