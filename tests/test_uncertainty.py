@@ -103,3 +103,34 @@ def test_tunnel_ensemble_reads_the_tunnel_scripts_files(tmp_path):
     assert q["σ at 2 mm [MPa], intact"] == 200.0
     assert q["first crack [ms], intact"] == pytest.approx(1.5826)
     assert q["spalled at the floor [mm²], intact"] == 198.0 and q["left waist moved in, p90 [mm], intact"] == 0.0157
+
+
+@pytest.mark.parametrize("scene", sorted(U.SHIFTS))
+def test_each_ensemble_table_runs_the_declared_shifts(scene):
+    """Every scripts/paper/*_shifts.table runs the shifts of uncertainty.SHIFTS (unshifted first), each line in the
+    folder named after its shift, under the ensemble folder the report reads."""
+    import os
+    from yade_mpm_paper import batch
+    from yade_mpm_paper.report.uncertainty_sections import ENSEMBLES
+    folder, table, script = ENSEMBLES[scene]
+    root = os.path.join(os.path.dirname(__file__), "..")
+    assert os.path.isfile(os.path.join(root, script))
+    runs = batch.lines(os.path.join(root, table))
+    tab = batch.read_table(os.path.join(root, table))
+    shifts = [U.parse_shift(batch._literal(tab[ln]["grid_shift"])) or (0.0, 0.0) for ln, _, _ in runs]
+    plain = [s for (ln, d, _), s in zip(runs, shifts) if "_l" not in d]     # the tunnel's other-spacing lines keep shift 0
+    assert plain == [tuple(s) for s in U.SHIFTS[scene]]
+    for (ln, desc, run_dir), s in zip(runs, shifts):
+        assert desc.startswith(U.shift_name(s)) and os.path.normpath(run_dir) == os.path.normpath(os.path.join("out", folder, desc))
+
+
+def test_benchmark_ensembles_read_the_scripts_summaries():
+    """The spread of the circular opening and the line crack reads the keys their scripts write (the summary names)."""
+    from yade_mpm_paper.report.uncertainty_sections import QUANTITIES
+    c = QUANTITIES["circular_opening"](None, dict(l2_rel_error_max=0.005, l2_rel_error_near_max=0.004, hoop_stress_theta0_MPa=11.4,
+                                                  hoop_stress_theta90_MPa=48.3))
+    assert sorted(c.values()) == [0.004, 0.005, 11.4, 48.3]
+    p = QUANTITIES["penny_crack"](None, dict(uy_l2_rel_error=0.07, uy_center_rel_error=-0.01, syy_ahead_l2_rel_error=0.09,
+                                             paper_comparison=dict(da_paper_cells=[34.0, 67.0, 91.0], initiation_t_paper_s=0.03)))
+    assert p["Δa at t = 0.4 s [cells] (paper 72)"] == 91.0 and p["first growth, t on the paper's axis [s]"] == 0.03
+    assert p["u_y L2 rel. error (Sneddon)"] == 0.07 and len(p) == 7

@@ -346,11 +346,13 @@ def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=Tr
     """Traction t [Pa] (a D-vector, e.g. σ0·n) on the flat face x_axis = face [m] of a particle lattice
     with ppc particles per cell per axis, side = -1 when the material lies above the face, +1 below.
     consistent=True spreads it over the outer rows with consistent_row_weights (recommended: exact
-    equilibrium with a uniform stress); False puts it all on the outermost row. Call before stepping."""
+    equilibrium with a uniform stress); False puts it all on the outermost row. A traction that varies
+    along the face: a callable t(points) → (n, D) array [Pa], called with the face points (n, D) [m] of
+    each loaded row's particles (their positions moved onto the face). Call before stepping."""
     _axis_side(solver, axis, side)
     d = dim_of(solver)
     face = _number(face, "face", "m")
-    t = _traction(traction, d)
+    t = traction if callable(traction) else _traction(traction, d)
     _integer(ppc, "ppc (particles per cell per axis)", 1)
     dp = solver.spacing / ppc                         # particle spacing = face length of a boundary particle
     beta = consistent_row_weights(ppc) if consistent else np.array([1.0])
@@ -372,4 +374,8 @@ def apply_face_traction(solver, axis, side, face, traction, ppc=2, consistent=Tr
                              f"{'lower' if side < 0 else 'upper'} edge of the particle lattice")
     area = dp ** (d - 1)                              # 2D: face length × 1 m thickness
     for r, b in zip(rows, beta):
-        apply_traction(solver, r, b * t, area)
+        if callable(t):                                # t at the face point of each particle of the row
+            pts = np.column_stack([solver.view(f"x{a}")[r] if a != axis else np.full(len(r), face) for a in range(d)])
+            apply_traction(solver, r, b * np.asarray(t(pts), float), area)
+        else:
+            apply_traction(solver, r, b * t, area)

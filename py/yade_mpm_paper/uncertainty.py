@@ -13,11 +13,15 @@ import re
 
 import numpy as np
 
-# Sub-cell grid shifts (fx, fy) of the ensembles, the unshifted run first. The uniaxial specimen stands on a slip
-# base (y = 0: fy ∈ {0, ½}) with free sides (any fx); the tunnel has slip walls left, right and below (fx, fy ∈ {0, ½}).
+# Sub-cell grid shifts (fx, fy) of the ensembles, the unshifted run first (each scene's scripts/paper/*_shifts.table).
+# The uniaxial specimen stands on a slip base (y = 0: fy ∈ {0, ½}) with free sides (any fx); the tunnel has slip walls
+# left, right and below (fx, fy ∈ {0, ½}); the circular opening's block has no plane (any fx, fy); the line crack's
+# block has slip faces at y = 0, L (fy ∈ {0, ½}).
 SHIFTS = {
     "uniaxial": ((0.0, 0.0), (0.2, 0.0), (0.4, 0.5), (0.6, 0.0), (0.8, 0.5)),
     "tunnel": ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)),   # and the grids of 74 and 76 cells across (scripts/paper/tunnel_shifts.table)
+    "circular_opening": ((0.0, 0.0), (0.2, 0.6), (0.4, 0.2), (0.6, 0.8), (0.8, 0.4)),
+    "penny_crack": ((0.0, 0.0), (0.2, 0.0), (0.4, 0.5), (0.6, 0.0), (0.8, 0.5)),
 }
 
 

@@ -38,7 +38,7 @@ import yade_mpm.output as out
 from yade_mpm_paper.validation import kirsch
 
 from yade_mpm import rocks, runner
-from yade_mpm_paper import batch, cases
+from yade_mpm_paper import batch, cases, uncertainty
 from yade_mpm_paper.cases import OPENING_CENTER as CENTER, OPENING_RADIUS as RADIUS, OPENING_SXX as SXX_FAR, OPENING_SYY as SYY_FAR
 
 MPa = 1e6
@@ -68,6 +68,10 @@ def parse_args(argv=None):
     p.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all cores)")
     p.add_argument("--progress", type=float, default=10.0, help="wall seconds between progress lines")
     ym.scene.courant_option(p)                      # default: the solver's C (pkg-mpm/core/SolverSettings.hpp)
+    uncertainty.shift_option(p)                     # the grid moved against the block (every run of the ladder)
+    p.add_argument("--far-field", choices=cases.FAR_FIELDS, default="uniform",
+                   help="load on the block faces: 'uniform' far-field stress (the paper's; the finite block differs from Kirsch's "
+                        "infinite plate by O((a/L)²)) or 'kirsch' (Kirsch's stress on the faces: the error is the discretisation's alone)")
     p.add_argument("--no-vtu", dest="vtu", action="store_false", help="skip the VTU particle file")
     p.add_argument("--vtu-every", type=float, default=0.0,
                    help="also write a VTU series of the main run (DIR/series/particles.pvd for ParaView) every this "
@@ -102,6 +106,7 @@ def check_args(a):
         raise ValueError(f"--vtu-every = {a.vtu_every} s must be ≥ 0 (0 = no series)")
     if a.progress <= 0:
         raise ValueError(f"--progress = {a.progress} s must be > 0")
+    a.grid_shift = uncertainty.parse_shift(a.grid_shift)
 
 
 def fits(l, domain):
@@ -232,7 +237,8 @@ def evaluate(s, samples, spacing, ppc, domain):
 
 def run_case(spacing, args, label, series=None):
     t0 = time.time()
-    s, _, _ = cases.circular_opening(spacing, args.domain, args.ppc, args.damping, args.boundary_load)
+    s, _, _ = cases.circular_opening(spacing, args.domain, args.ppc, args.damping, args.boundary_load, grid_shift=args.grid_shift,
+                                     far_field=args.far_field)
     s.courant = args.courant
     samples = LineSamples(s, spacing, args.ppc)
     converged, hist = relax(s, samples, args, spacing, label, series)
@@ -354,6 +360,7 @@ def main(argv=None):
     summary = dict(case="circular opening (paper Sec. 3.1) vs Kirsch (Eqs. 41-42)", domain_m=args.domain,
                    hole_radius_m=RADIUS, far_field_MPa=dict(sxx=SXX_FAR / MPa, syy=SYY_FAR / MPa),
                    ppc=args.ppc, damping=args.damping, courant=args.courant, boundary_load=args.boundary_load, tol=args.tol, threads=ym.getThreads(),
+                   grid_shift=args.grid_shift, far_field=args.far_field,
                    kirsch_hoop_theta0_MPa=3 * SYY_FAR / MPa - SXX_FAR / MPa,
                    kirsch_hoop_theta90_MPa=3 * SXX_FAR / MPa - SYY_FAR / MPa)
     summary.update(main_res)

@@ -39,7 +39,7 @@ from yade_mpm_paper.validation import sneddon
 from yade_mpm_paper.validation.line_crack import PAPER_DA, crack_extension, elastic_profiles, face_opening, interp_da, paper_comparison
 
 from yade_mpm import rocks, runner
-from yade_mpm_paper import batch, cases
+from yade_mpm_paper import batch, cases, uncertainty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import penny_crack_figures as figures  # noqa: E402  (the sibling module: this script's figures)
@@ -51,12 +51,13 @@ COURANT = ym.scene.setting_default("courant")   # --courant sets it (default: th
 SNAP_T = [0.05, 0.1, 0.2, 0.4]         # paper times of the damage-field figures [s]
 
 
-def build(size, h, material, P, ramp, damping, crack_nodes="shared", edges="free", edge_set="topbottom"):
+def build(size, h, material, P, ramp, damping, crack_nodes="shared", edges="free", edge_set="topbottom", grid_shift=None):
     """The cracked block (yade_mpm_paper.cases.line_crack) with the outer boundary `edges` on `edge_set`;
     returns (solver, crack geometry dict). Outer boundary: grid-node planes on the block faces (free =
     none); "slip" zeroes the normal velocity, "fixed" every component; "topbottom" acts on the faces
-    y = 0, L only, "all" also on x = 0, L."""
-    s, geo = cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK)
+    y = 0, L only, "all" also on x = 0, L. grid_shift: (fx, fy) fractions of a cell by which the grid is moved
+    against the block (a slip or fixed face takes 0 or 0.5 along its axis)."""
+    s, geo = cases.line_crack(size, h, material, P, ramp, damping, crack_nodes, HALF_CRACK, grid_shift=grid_shift)
     s.courant = COURANT
     if edges != "free":
         for axis in ((1,) if edge_set == "topbottom" else (0, 1)):
@@ -71,7 +72,7 @@ def run_elastic(size, h, P, args):
     cp = math.sqrt((mat.young * (1 - mat.poisson) / ((1 + mat.poisson) * (1 - 2 * mat.poisson))) / mat.density)
     transit = size / cp
     s, geo = build(size, h, mat, P, ramp=2 * transit, damping=args.elastic_damping, crack_nodes=args.crack_nodes,
-                   edges=args.edges, edge_set=args.edge_set)
+                   edges=args.edges, edge_set=args.edge_set, grid_shift=args.grid_shift)
     t0 = time.time()
     ref = sneddon.opening_displacement(0.0, P, ROCK["young"], ROCK["poisson"], HALF_CRACK)
     hist = []
@@ -108,7 +109,7 @@ def run_damage(args, law, outdir):
     scale = PAPER_RAMP / ramp                                  # t_paper = scale · t
     mat = rocks.granite_dpgk(**damage_options(args, law))
     s, geo = build(size, h, mat, args.damage_pressure, ramp=ramp, damping=args.damage_damping, crack_nodes=args.crack_nodes,
-                   edges=args.edges, edge_set=args.edge_set)
+                   edges=args.edges, edge_set=args.edge_set, grid_shift=args.grid_shift)
     t_end = args.end_time / scale
     rec_dt = args.record_every / scale
     rows = []
@@ -191,6 +192,7 @@ def option_parser():
     ap.add_argument("--threads", type=int, default=0, help="OpenMP threads (0 = all)")
     ap.add_argument("--progress", type=float, default=20.0, help="progress line interval [s wall]")
     ym.scene.courant_option(ap)
+    uncertainty.shift_option(ap)   # the grid moved against the block (every run)
     return ap
 
 
@@ -213,6 +215,7 @@ def parse_options(argv):
             ap.error(f"--laws: {law!r} is not one of {CHOICES['growthLaw']}")
     try:
         courant = ym.scene.check_courant(a.courant)
+        a.grid_shift = uncertainty.parse_shift(a.grid_shift)
     except ValueError as e:
         ap.error(str(e))
     return a, parts, courant
@@ -226,7 +229,7 @@ def run_config(a):
                 threshold_volume=rocks.granite_dpgk(**damage_options(a, "benz-asphaug")).thresholdVolume,
                 damage_strain=a.damage_strain,
                 threshold_cell_m=a.threshold_cell, flaws=a.flaws, flaw_seed=a.flaw_seed, crack_nodes=a.crack_nodes, half_length_m=a.half_length,
-                edges=a.edges, edge_set=a.edge_set, courant=COURANT, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
+                edges=a.edges, edge_set=a.edge_set, grid_shift=a.grid_shift, courant=COURANT, elastic_pressure_Pa=a.elastic_pressure, damage_pressure_Pa=a.damage_pressure,
                 threads=ym.getThreads())
 
 

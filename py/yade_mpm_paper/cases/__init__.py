@@ -21,7 +21,7 @@ checks in ``yade_mpm_paper.validation.stability_cases``. Modules: elastic (Secs.
 tunnel (Sec. 4), uniaxial (Sec. 3.3), loading (YADE bodies), tunnel_results, uniaxial_results
 (imported by name: ``from yade_mpm_paper.cases import tunnel_results``). Quantities are SI; stresses are tension positive inside the solver.
 """
-from .elastic import (CRACK_HALF_LENGTH, OPENING_CENTER, OPENING_RADIUS, OPENING_SXX, OPENING_SYY, apply_far_field,
+from .elastic import (CRACK_HALF_LENGTH, FAR_FIELDS, OPENING_CENTER, OPENING_RADIUS, OPENING_SXX, OPENING_SYY, apply_far_field,
                       circular_opening, drifting_block, fixed_free_bar, line_crack, mode_period, uniform_stress_block)
 from .loading import (BODY_HALF_THICKNESS, FILLER_CHI, PLATEN_FRICTION, PLATEN_SPEED, blocked_dofs, yade_engines, yade_filler,
                       yade_platen)

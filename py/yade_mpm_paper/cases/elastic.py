@@ -16,35 +16,55 @@ OPENING_SXX = 20e6          # far-field compression σxx [Pa], compression posit
 OPENING_SYY = 10e6          # far-field compression σyy [Pa]
 
 
-def apply_far_field(solver, lo, hi, ppc, sxx, syy, boundary_load="consistent", sides=(-1, 1)):
+def apply_far_field(solver, lo, hi, ppc, sxx, syy, boundary_load="consistent", sides=(-1, 1), field=None):
     """Far-field traction t = σ0·n (σ0 = diag(sxx, syy), tension positive [Pa]) on the four faces of
     the 2D block [lo, hi] [m]: spread over the outer particle rows with ``consistent_row_weights``
     (boundary_load="consistent", exact discrete equilibrium of the intact block) or on the outermost
-    row only ("outer-row"). sides: the faces loaded along each axis (a quarter model loads only +1)."""
+    row only ("outer-row"). sides: the faces loaded along each axis (a quarter model loads only +1).
+    field: instead of σ0, a stress field σ(points) → (σxx, σyy, σxy) arrays [Pa, tension positive] whose
+    traction σ·n is applied at each face point (e.g. Kirsch's, so the finite block carries the infinite plate's solution)."""
     if boundary_load not in ("consistent", "outer-row"):
         raise ValueError(f"boundary_load = {boundary_load!r} must be 'consistent' or 'outer-row'")
     for axis, far in ((0, sxx), (1, syy)):
         for side, face in ((sd, lo[axis] if sd < 0 else hi[axis]) for sd in sides):
             t = np.zeros(2)
             t[axis] = side * far                  # σ0·n with n = side·e_axis: compression pushes inwards
+            if field is not None:                 # (σ·n)_a = σ_a,axis · side
+                def t(pts, axis=axis, side=side):
+                    sxx_, syy_, sxy_ = field(pts)
+                    return side * (np.column_stack((sxx_, sxy_)) if axis == 0 else np.column_stack((sxy_, syy_)))
             apply_face_traction(solver, axis, side, face, t, ppc, consistent=(boundary_load == "consistent"))
 
 
-def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="consistent", material=None, quarter=False):
+FAR_FIELDS = ("uniform", "kirsch")   # the block faces' load: the paper's uniform far field, or Kirsch's stress there
+
+
+def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="consistent", material=None, quarter=False,
+                     grid_shift=None, far_field="uniform"):
     """Square block of side `domain` [m] centred on (2.5, 2.5) m with a hole of radius 0.1 m, every
     particle at the in-situ stress (σxx, σyy) = (−20, −10) MPa, σzz = ν(σxx + σyy) (plane strain), and
     the far-field traction on its faces, so only the hole wall is out of balance ("excavation").
     material: default ``rocks.granite()``. quarter=True models the quadrant x, y ≥ 2.5 m only, with
-    slip (symmetry) planes on x = 2.5 m and y = 2.5 m (doc/reference/boundaries.md). Returns (solver, lo, hi)."""
+    slip (symmetry) planes on x = 2.5 m and y = 2.5 m (doc/reference/boundaries.md). grid_shift: (fx, fy) fractions of a
+    cell by which the grid is moved against the block (``make_solver``'s `shift`; the quarter model's symmetry planes
+    take 0 or 0.5 only). far_field: "uniform" (the paper's: σ0·n on the faces; the finite block then differs from
+    Kirsch's infinite plate by O((a/L)²)) or "kirsch" (Kirsch's stress σ_K·n on the faces: the block's exact solution is
+    Kirsch's, so the error against it is the discretisation's alone — for convergence studies). Returns (solver, lo, hi)."""
+    if far_field not in FAR_FIELDS:
+        raise ValueError(f"far_field = {far_field!r} must be one of {FAR_FIELDS}")
     mat = material or rocks.granite()
     lo, hi = np.full(2, OPENING_CENTER - domain / 2), np.full(2, OPENING_CENTER + domain / 2)
     if quarter:
         lo = np.full(2, OPENING_CENTER)
-    s = make_solver(lo, hi, spacing, margin=2)
+    s = make_solver(lo, hi, spacing, margin=2, shift=grid_shift)
     add_region(s, mat, lo, hi, ppc=ppc, holes=[Circle((OPENING_CENTER, OPENING_CENTER), OPENING_RADIUS)])
     sxx, syy = -OPENING_SXX, -OPENING_SYY     # tension positive inside the solver
     set_initial_stress(s, (sxx, syy, mat.poisson * (sxx + syy), 0.0))
-    apply_far_field(s, lo, hi, ppc, sxx, syy, boundary_load, sides=(1,) if quarter else (-1, 1))
+    field = None
+    if far_field == "kirsch":                 # Eqs. 41–42 at the face points, tension positive
+        from ..validation import kirsch
+        field = lambda p: tuple(-c for c in kirsch.cartesian(p[:, 0], p[:, 1], (OPENING_CENTER,) * 2, OPENING_RADIUS, OPENING_SXX, OPENING_SYY))
+    apply_far_field(s, lo, hi, ppc, sxx, syy, boundary_load, sides=(1,) if quarter else (-1, 1), field=field)
     if quarter:
         s.addBoundaryPlane(0, -1, OPENING_CENTER, "slip")
         s.addBoundaryPlane(1, -1, OPENING_CENTER, "slip")
@@ -57,14 +77,17 @@ def circular_opening(spacing, domain=4.8, ppc=2, damping=0.5, boundary_load="con
 CRACK_HALF_LENGTH = 0.2     # c [m] (crack length 0.4 m)
 
 
-def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="excluded", half_length=CRACK_HALF_LENGTH):
+def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="excluded", half_length=CRACK_HALF_LENGTH,
+               grid_shift=None):
     """Square block [0, size]² [m] with a line crack of half-length c at its centre, made by removing
     the particles of two cell layers (ppc = 2); the crack faces carry the pressure P [Pa] as a particle
     traction, ramped linearly over `ramp` [s]. crack_nodes = "excluded" (default) takes the grid nodes
     between the faces out of the WLS fits (``add_region(gap_nodes="excluded")``, ``scene.thin_gap_nodes``):
     the faces are 2 cells apart and the cubic B-spline reaches 2 cells, so with "shared" (the paper's
     construction) both faces map to the mid-line node row and stay tied — the opening then moves away
-    from Sneddon as the grid is refined (doc/reference/boundaries.md).
+    from Sneddon as the grid is refined (doc/reference/boundaries.md). grid_shift: (fx, fy) fractions of a cell by
+    which the grid is moved against the block (``make_solver``'s `shift`): the particles and the crack stay where
+    they are, the grid cuts them anew (slip planes on the block's faces take 0 or 0.5 along their axis).
 
     Returns (solver, geo): geo = dict(xc, yc, h, dp, x0 (initial positions by id), top, bot (particle
     ids of the loaded face rows), half_length)."""
@@ -73,7 +96,7 @@ def line_crack(size, spacing, material, pressure, ramp, damping, crack_nodes="ex
     if not (np.isfinite(half_length) and 0 < half_length < size / 2 - 2 * spacing):
         raise ValueError(f"half_length = {half_length} m must lie in (0, size/2 − 2·spacing) = (0, {size / 2 - 2 * spacing:g}) m")
     h = spacing
-    s = make_solver((0, 0), (size, size), h, margin=2)
+    s = make_solver((0, 0), (size, size), h, margin=2, shift=grid_shift)
     xc = yc = round(size / 2 / h) * h   # crack centre on a grid line so the hole is exactly two cell layers
     crack = Box((xc - half_length, yc - h), (xc + half_length, yc + h))
     add_region(s, material, (0, 0), (size, size), ppc=2, holes=[crack], gap_nodes=crack_nodes)

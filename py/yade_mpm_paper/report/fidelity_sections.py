@@ -67,17 +67,19 @@ def ensemble_rows(R, rows, parts):
     from yade_mpm_paper.fidelity import table as fidelity_table
     from .uncertainty_sections import members
     said = []
-    for scene, part in (("uniaxial", "uniaxial_flaw"), ("tunnel", "tunnel")):
+    for scene, scene_parts in (("uniaxial", ("uniaxial_flaw",)), ("tunnel", ("tunnel",)), ("circular_opening", ("circular_opening",)),
+                               ("penny_crack", ("penny_crack", "penny_crack_damage"))):   # one penny run: elastic and damage parts
         ms = members(R, scene)
         if len(ms) < 2:
             continue
         per = []
         for _, f in ms:
             p = dict(parts)
-            p[part] = load_tunnel(R, part, f) if scene == "tunnel" else json.load(open(os.path.join(f, "summary.json")))
+            for part in scene_parts:
+                p[part] = load_tunnel(R, part, f) if scene == "tunnel" else json.load(open(os.path.join(f, "summary.json")))
             per.append(fidelity_table.rows(p))
         for i, r in enumerate(rows):
-            if r["part"] == part:
+            if r["part"] in scene_parts:
                 r["default"] = uncertainty.merge_texts([pr[i]["default"] for pr in per])
                 r["verdict"] = uncertainty.combined_verdict([pr[i]["verdict"] for pr in per])
         said.append(f"{scene} rows over {len(ms)} runs of the default grid, shifted by {', '.join(m for m, _ in ms)}")

@@ -8,8 +8,11 @@ import os
 from .. import uncertainty
 from .document import include_notes, shown
 
+# scene → (folder under the output root, sweep table, script); fidelity_sections.ensemble_rows maps each to its fidelity rows
 ENSEMBLES = {"uniaxial": ("ensemble/uniaxial", "scripts/paper/uniaxial_shifts.table", "scripts/paper/uniaxial_flaw.py"),
-             "tunnel": ("ensemble/tunnel", "scripts/paper/tunnel_shifts.table", "scripts/paper/tunnel_spalling.py")}
+             "tunnel": ("ensemble/tunnel", "scripts/paper/tunnel_shifts.table", "scripts/paper/tunnel_spalling.py"),
+             "circular_opening": ("ensemble/circular_opening", "scripts/paper/circular_shifts.table", "scripts/paper/circular_opening.py"),
+             "penny_crack": ("ensemble/penny_crack", "scripts/paper/penny_shifts.table", "scripts/paper/penny_crack.py")}
 
 
 def command(scene):
@@ -92,6 +95,30 @@ def _tunnel_quantities(folder, summary):
     return q
 
 
+def _circular_quantities(summary):
+    """name → value of one circular-opening run (scripts/paper/circular_opening.py's summary): the Kirsch errors."""
+    return {"max L2 rel. error of σxx, σyy (r ≥ 2a)": summary.get("l2_rel_error_max"),
+            "max L2 rel. error near the hole": summary.get("l2_rel_error_near_max"),
+            "hoop stress at θ = 0° [MPa] (Kirsch 10)": summary.get("hoop_stress_theta0_MPa"),
+            "hoop stress at θ = 90° [MPa] (Kirsch 50)": summary.get("hoop_stress_theta90_MPa")}
+
+
+def _penny_quantities(summary):
+    """name → value of one line-crack run (scripts/paper/penny_crack.py's summary): Sneddon errors and the crack growth."""
+    q = {"u_y L2 rel. error (Sneddon)": summary.get("uy_l2_rel_error"), "u_y rel. error at the centre": summary.get("uy_center_rel_error"),
+         "σyy ahead of the tip, L2 rel. error": summary.get("syy_ahead_l2_rel_error")}
+    c = summary.get("paper_comparison") or {}
+    for t, da in zip((0.1, 0.2, 0.4), c.get("da_paper_cells") or ()):
+        q[f"Δa at t = {t:g} s [cells] (paper {dict(((0.1, 7), (0.2, 22), (0.4, 72)))[t]})"] = da
+    if c:
+        q["first growth, t on the paper's axis [s]"] = c.get("initiation_t_paper_s")
+    return q
+
+
+QUANTITIES = {"uniaxial": lambda f, s: _uniaxial_quantities(s), "tunnel": _tunnel_quantities,
+              "circular_opening": lambda f, s: _circular_quantities(s), "penny_crack": lambda f, s: _penny_quantities(s)}
+
+
 def ensemble_section(R):
     R.w("## Spread over where the grid cuts the specimen", "",
         "The default-grid runs repeated with the grid moved against the specimen by sub-cell shifts (`yade_mpm.make_solver`'s "
@@ -109,7 +136,7 @@ def ensemble_section(R):
         per = []
         for _, f in ms:
             s = json.load(open(os.path.join(f, "summary.json")))
-            per.append(_uniaxial_quantities(s) if scene == "uniaxial" else _tunnel_quantities(f, s))
+            per.append(QUANTITIES[scene](f, s))
         names = [k for k in per[0]] + [k for p in per[1:] for k in p if k not in per[0]]
         R.w("| quantity | unshifted | mean | min–max | CV | n |", "|---|---|---|---|---|---|")
         for k in dict.fromkeys(names):
