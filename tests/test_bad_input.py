@@ -235,6 +235,7 @@ def test_face_traction_on_a_face_without_particles_refused():
     (lambda: ym.boundary_particles(_solver(), 5, 1), r"axis = 5 must be an integer in \[0, 1\]"),
     (lambda: ym.set_initial_stress(_solver(), "abcd"), r"initial stress must be 4 numbers"),
     (lambda: ym.scene.consistent_row_weights(10 ** 6), r"ppc .* = 1000000 must be an integer in \[2, 16\]"),
+    (lambda: ym.scene.consistent_row_weights(2, 1.0), r"offset = 1.0 cells must lie in \[0, 1\)"),
     (lambda: ym.add_region(None, ym.rocks.granite(), (0, 0), (1, 1)), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
 ])
 def test_scene_helpers_name_the_parameter(call, msg):
