@@ -13,12 +13,13 @@ Folders read (each optional; a missing one is reported with the command that mak
     circular_opening_paper/, penny_crack_paper/   the elastic benchmarks at the paper's grid (0.01 m, 0.02 m)
     stability/         scripts/paper/stability.py
     uniaxial_flaw/     scripts/paper/uniaxial_flaw.py
-    uniaxial_paper/    scripts/paper/uniaxial_flaw.py --paper   (paper grid: open, filled μ_con 0 and 0.6, c_con 5 and 10 MPa)
+    uniaxial_paper/    scripts/paper/uniaxial_flaw.py --paper   (paper grid, 0.5 mm: the whole sweep, one run per --runs entry)
     tunnel/            scripts/paper/tunnel_spalling.py            (default grid, all four cases)
     tunnel_paper/      scripts/paper/tunnel_spalling.py --paper    (paper grid)
     fidelity_variants/ scripts/paper/fidelity_variants.py          (variant screening; notes.md: how it was run)
     convergence/       scripts/paper/convergence.py                (error against run time, every reference case)
-    ensemble/uniaxial/, ensemble/tunnel/   scripts/studies/sweep.py scripts/paper/{uniaxial,tunnel}_shifts.table ...
+    ensemble/uniaxial/, ensemble/tunnel/, ensemble/circular_opening/, ensemble/penny_crack/
+                       scripts/studies/sweep.py scripts/paper/{uniaxial,tunnel,circular,penny}_shifts.table ...
                        (the default grid shifted against the specimen: the spread of every fidelity number; the unshifted
                        run s0.00_0.00 is the default run when uniaxial_flaw/ or tunnel/ is absent)
     fidelity_notes.md  how the runs of the fidelity table were made (build, commands, wall times)

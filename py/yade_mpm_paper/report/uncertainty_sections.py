@@ -148,3 +148,4 @@ def ensemble_section(R):
             R.w(f"| {k} | {'never' if v0 is None else f'{v0:.4g}'} | {sp['mean']:.4g} | {sp['min']:.4g}–{sp['max']:.4g} | "
                 f"{100 * sp['cv']:.1f} % | {sp['n']} of {len(per)} |")
         R.w("")
+        include_notes(R, os.path.join(R.root, ENSEMBLES[scene][0], "notes.md"))   # what the runs showed (written with them)
