@@ -85,3 +85,24 @@ def test_compression_run_ends_cleanly_on_sigterm(tmp_path):
     c = np.loadtxt(tmp_path / "curve.csv", delimiter=",", skiprows=1)
     assert 20 <= len(c) <= 21 and c[-1, 2] > 0
     assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL       # the handler is gone after the run
+
+
+def test_end_analytics_of_a_run_stopped_on_a_singular_fit():
+    # A run the solver stopped on a singular WLS fit (a fragment with its stencil nodes excluded, next to a body) still
+    # reports its cracks: the end analytics read no field that needs a fit at the current positions (the material
+    # velocity does, and raises). Here every node is excluded, so every particle's fit is singular.
+    import yade_mpm as ym
+    from yade_mpm import analysis
+    from yade_mpm_paper import cases
+    s, sc = cases.uniaxial_flaw("intact", 0.005, side_room=0.01)
+    s.run(3)
+    for i in range(len(s._excludedNodes())):
+        try:
+            s._setNodeExcluded(i, True)
+        except ValueError:                                  # a ghost node: excluded already
+            pass
+    with pytest.raises(ym.MpmSimulationError, match="singular"):
+        ym.get(s, "vel")
+    lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))
+    end = uniaxial_results.end_analytics(s, lattice, None, {}, s.spacing)
+    assert end["damaged_fraction_end"] == 0.0 and end["cracks_end"] == []

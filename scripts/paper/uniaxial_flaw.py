@@ -110,7 +110,12 @@ def one_run(variant, mu, c_mpa, a):
     wall, t, eps, sig, k, E = r["wall_s"], r["t"], r["eps"], r["sig"], r["peak"], r["E"]
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
     # cracks and shear bands at the end (yade_mpm.analysis); σ̃max within 2 particle rows of the flaw (Figs. 14–15)
-    end = results.end_analytics(s, lattice, fl, snaps, a.spacing)
+    try:
+        end = results.end_analytics(s, lattice, fl, snaps, a.spacing)
+    except (ym.MpmSimulationError, RuntimeError, ValueError) as e:   # the run keeps its curve and peak; the reason is recorded
+        print(f"[{name}] end analytics failed: {e}", flush=True)
+        end = dict.fromkeys(("damaged_fraction_end", "cracks_end", "shear_bands_end", "near_flaw_sigma_max", "flaw_end_cracks_end"))
+        end["error"] = str(e)
     entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
                  strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
@@ -121,7 +126,8 @@ def one_run(variant, mu, c_mpa, a):
                  **{q: end[q] for q in ("damaged_fraction_end", "cracks_end", "shear_bands_end")},
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
                  plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"],
-                 removed_particles=int(ym.removed(s)["count"]), removed_mass_kg=float(ym.removed(s)["mass"]))   # debris off the grid
+                 removed_particles=int(ym.removed(s)["count"]), removed_mass_kg=float(ym.removed(s)["mass"]),   # debris off the grid
+                 end_analytics_error=end.get("error"))
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
