@@ -28,11 +28,12 @@ inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Rea
 	const KernelGeom<D> geo(tr.grid); // firstprivate: a local of each thread, not reloaded after the particle stores
 #pragma omp parallel for schedule(dynamic, 4) reduction(min : rmin) reduction(max : v2max) reduction(| : drift) firstprivate(geo)
 	for (long b = 0; b < nb; ++b) {
+		const Stencil<D>* fits = tr.cuts.block(uint32_t(b)); // P2G's cut-stencil fits of this block, in order (or none)
 		for (uint32_t pp = blocks[b]; pp < blocks[b + 1]; ++pp) {
 			const size_t p = pp;
 			Real L[D][D] = {}, dbar[D];
 			bool cut;
-			if (!tr.velocityGradient(geo, p, L, cut, dbar)) {
+			if (!tr.velocityGradient(geo, p, L, cut, dbar, fits)) {
 				err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 				continue;
 			}

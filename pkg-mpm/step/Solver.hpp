@@ -177,6 +177,7 @@ public:
 		if (in.flip)
 			for (auto& c : xfer.vg) c.resize(P.n); // grows only with the particle count
 		if (in.withContact) contact.beforeTransfer(cs);
+		xfer.cuts.beginStep(sched.start.size() - 1, omp_get_max_threads()); // the cut-stencil fits P2G keeps for this step
 		double t[6] = { omp_get_wtime() };
 		materials.dispatch([&](const auto& mat) {
 			gridPhases(xfer, contact, cs, mat, in, errP2G, errG2P, t); // MuslStep.hpp: phases 1–5
@@ -190,6 +191,7 @@ public:
 			if (errMove.leftAnywhere) settleLeaving(errMove, dt); // a particle left the grid (on some rank): outside policy
 			vmax = std::sqrt(st.v2max), dtDensityMin = st.dtDensityMin;
 			if (st.drift) needSort = true; // a particle left its block's reach: re-sort before the next scatter
+			xfer.cuts.endStep();           // room for the cut-stencil fits this step could not keep
 			t[5] = omp_get_wtime();
 		});
 		phase.sort += t[0] - t0, phase.p2g += t[1] - t[0], phase.grid += t[2] - t[1], phase.contact += t[3] - t[2];

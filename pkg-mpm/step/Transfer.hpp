@@ -4,6 +4,7 @@
 // thread of the solver's parallel region and record failures in an ErrorRecord.
 #pragma once
 #include "../core/BlockSchedule.hpp"
+#include "CutStencilCache.hpp"
 #include "Kinematics.hpp"
 #include "../core/Lanes.hpp"
 #include <atomic>
@@ -19,6 +20,8 @@ public:
 	Particles<D>&           P;
 	const BlockSchedule<D>& sched;
 	const StencilOffsets<D> offs; // linear-index offsets of the 4^D stencil nodes
+
+	CutStencilCache<D>      cuts; // the step's cut-stencil fits (P2G makes them, G2P and the stress pass read them)
 
 	Transfer(Grid<D>& g, Particles<D>& p, const BlockSchedule<D>& s) : grid(g), P(p), sched(s), offs(g) { }
 
@@ -96,6 +99,11 @@ public:
 			const Real          Dinv = g.gradFactor; // interior M⁻¹ gradient factor 3/l²
 			Real cellLo[D], cellHi[D]; // cells a particle of this block may reach: beyond, the colouring breaks
 			if constexpr (checkViews) sched.reach(blk, cellLo, cellHi);
+			const int t         = omp_get_thread_num(); // this block's cut-stencil fits go to thread t's store
+			auto&     cutStore  = cuts.store[size_t(t)];
+			uint32_t& cutUsed   = cuts.used[size_t(t)];
+			bool      cutCached = true;
+			cuts.owner[blk] = uint32_t(t), cuts.start[blk] = cutUsed;
 			// The interior path runs inline in the particle loop; cut stencils (p2gCut) and messages are out of line.
 			for (uint32_t pp = sched.start[blk]; pp < sched.start[blk + 1]; ++pp) {
 				const size_t p = pp;
@@ -127,7 +135,9 @@ public:
 					fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
 				}
 				if (k.general) {
-					p2gCut<fused>(p, k, m, V, sg, mv, mC, fe, dt, err);
+					++cuts.need[size_t(t)];
+					cutCached = cutCached && cutUsed < cutStore.size();
+					p2gCut<fused>(p, k, cutCached ? &cutStore[cutUsed++] : nullptr, m, V, sg, mv, mC, fe, dt, err);
 					continue;
 				}
 				Real sgm[D][D];
@@ -157,6 +167,7 @@ public:
 					scatterAffine(grid, k, P0, A); // Eqs. 20–22 with ψ = w: w (P0 + Σ_b A_b (x_i − x_p)_b)
 				}
 			}
+			if (!cutCached) cuts.start[blk] = CutStencilCache<D>::none; // some fit did not fit: the later passes fit again
 		});
 	}
 
@@ -178,7 +189,8 @@ public:
 	{
 		const KernelGeom<D> geo(grid);
 		scatterBlocks([&](uint32_t blk) {
-			const KernelGeom<D> g = geo; // a local: not reloaded after the stores
+			const KernelGeom<D> g   = geo; // a local: not reloaded after the stores
+			const Stencil<D>*   cut = cuts.block(blk); // P2G's fits of this block's cut stencils, in order (or none)
 			for (uint32_t pp = sched.start[blk]; pp < sched.start[blk + 1]; ++pp) {
 				const size_t p = pp;
 				Kernel<D>    k;
@@ -186,7 +198,7 @@ public:
 				for (int a = 0; a < D; ++a) x[a] = P.x[a][p];
 				computeKernel<D, false>(g, x, k);
 				if (k.general) {
-					g2pCut<flip>(p, k, err);
+					g2pCut<flip>(p, k, cut ? cut++ : nullptr, err);
 					continue;
 				}
 				const Real m = P.mass[p];
@@ -209,8 +221,8 @@ public:
 
 	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (vmusl, Eq. 7). False if the WLS fit is singular.
 	// general: a cut stencil, whose v_p stands at x̄_p = x_p + dbar (g2p); dbar is left untouched otherwise.
-	// g: KernelGeom of the grid, made once per pass.
-	bool velocityGradient(const KernelGeom<D>& g, size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D]) const
+	// g: KernelGeom of the grid, made once per pass; cut: the block's next cached fit (cuts.block), advanced when used.
+	bool velocityGradient(const KernelGeom<D>& g, size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D], const Stencil<D>*& cut) const
 	{
 		Kernel<D> k;
 		Real      x[D];
@@ -222,7 +234,7 @@ public:
 			gatherPacked(grid, grid.vmusl, k, g.gradFactor, v, L);
 			return true;
 		}
-		return velocityGradientCut(p, k, L, dbar);
+		return velocityGradientCut(k, cut ? cut++ : nullptr, L, dbar);
 	}
 
 	// Velocity of the material point x_p: v_p + C_p (x_p − x̄_p). A cut stencil's v_p is the velocity at x̄_p (g2p:
@@ -260,11 +272,13 @@ private:
 	// (WlsShape.hpp), the particle's velocity v_p standing at the centroid x̄_p = x_p + dbar of its weights
 	// (Σ η (x_i − x̄_p) = 0: momentum conserved); internal force with the fitted ∇ψ (Σ_i ∇ψ_i = 0). Out of line:
 	// the interior loop stays small.
+	// slot: where the fit is kept for G2P and the stress pass (nullptr: not kept).
 	template <bool fused>
-	[[gnu::noinline]] void p2gCut(size_t p, const Kernel<D>& k, Real m, Real V, const Sym<D>& sg, const Real (&mv)[D], const Real (&mC)[D][D], const Real (&fe)[D],
-	                              Real dt, ErrorRecord& err)
+	[[gnu::noinline]] void p2gCut(size_t p, const Kernel<D>& k, Stencil<D>* slot, Real m, Real V, const Sym<D>& sg, const Real (&mv)[D], const Real (&mC)[D][D],
+	                              const Real (&fe)[D], Real dt, ErrorRecord& err)
 	{
-		Stencil<D> st;
+		Stencil<D>  local;
+		Stencil<D>& st = slot ? *slot : local;
 		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
 		forStencil(grid.nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
 			const Real eta = st.eta[n];
@@ -286,11 +300,13 @@ private:
 	// G2P of a particle with a cut stencil: v_p = Σ η_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum
 	// conserved; exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 	// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
+	// cached: P2G's fit of this particle (nullptr: fit again; P2G accepted it, so it is not singular).
 	template <bool flip>
-	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, ErrorRecord& err)
+	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, const Stencil<D>* cached, ErrorRecord& err)
 	{
-		Stencil<D> st;
-		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+		Stencil<D> local;
+		if (!cached && !fillStencil(grid, offs, k, local)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+		const Stencil<D>& st = cached ? *cached : local;
 		const Real m = P.mass[p];
 		Real       v[D] = {}, C[D][D] = {};
 		forStencil(grid.vel.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
@@ -322,12 +338,12 @@ private:
 		for (int a = 0; a < D; ++a) vg[a][p] = v[a], vf[a] = P.v[a][p] + (v[a] - vo[a]);
 		storeVelocity(p, vf, C);
 	}
-	// The stress-pass gather of a cut stencil (velocityGradient).
-	[[gnu::noinline]] bool velocityGradientCut(size_t p, const Kernel<D>& k, Real (&L)[D][D], Real (&dbar)[D]) const
+	// The stress-pass gather of a cut stencil (velocityGradient); cached: P2G's fit (nullptr: fit again).
+	[[gnu::noinline]] bool velocityGradientCut(const Kernel<D>& k, const Stencil<D>* cached, Real (&L)[D][D], Real (&dbar)[D]) const
 	{
-		(void)p;
-		Stencil<D> st;
-		if (!fillStencil(grid, offs, k, st)) return false;
+		Stencil<D> local;
+		if (!cached && !fillStencil(grid, offs, k, local)) return false;
+		const Stencil<D>& st = cached ? *cached : local;
 		for (int a = 0; a < D; ++a) dbar[a] = st.dbar[a];
 		forStencil(grid.vmusl.data(), offs, st, [&](const NodeVec<D>& nd, int n, const Real(&)[D]) {
 			for (int a = 0; a < D; ++a)
