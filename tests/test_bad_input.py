@@ -313,6 +313,7 @@ def test_set_particle_forces_is_all_or_nothing():
     (lambda: _solver()._setParticleForces([], []), r"forces must be an \(N, 2\) array"),
     (lambda: ym.make_solver((0, 0), (1, 1), True), r"spacing must be a number \[m\] \(got bool True\)"),
     (lambda: ym.get(None, "pos"), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
+    (lambda: ym.fields(_solver(), exclude=("velocity",)), r"exclude: unknown field\(s\) \['velocity'\]; known: id, pos, vel"),
     (lambda: ym.MpmEngine(None), r"solver must be a Solver2D or Solver3D \(got NoneType\)"),
     (lambda: ym.progress.Progress(np.nan), r"Progress end_time = nan s is outside"),
     (lambda: ym.progress.Progress(-1.0), r"Progress end_time = -1.0 s is outside the allowed range \[0, inf\)"),

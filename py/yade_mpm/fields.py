@@ -176,12 +176,17 @@ def _get_live(solver, name, o, d):
     return solver.view(FIELDS[name][0])[o].copy()
 
 
-def fields(solver, names=None):
-    """Several fields of one state (default: every field of ``FIELDS`` the scene has), each a copy in
-    particle-id order, plus 'time' [s] and 'steps'; a dict ready for ``np.savez`` or ``analysis``."""
+def fields(solver, names=None, exclude=()):
+    """Several fields of one state (default: every field of ``FIELDS`` the scene has), less those named in
+    `exclude`, each a copy in particle-id order, plus 'time' [s] and 'steps'; a dict ready for ``np.savez`` or
+    ``analysis``."""
+    bad = [n for n in exclude if n not in FIELDS]
+    if bad:
+        raise ValueError(f"exclude: unknown field(s) {bad}; known: {', '.join(FIELDS)}")
     o = id_order(solver)
     if names is None:
         names = [n for n in FIELDS if n != "cohesion" or 1 in solver._materialKinds]
+    names = [n for n in names if n not in exclude]
     out = {n: get(solver, n, o) for n in names}
     out["time"], out["steps"] = float(solver.time), int(solver.steps)
     return out

@@ -11,7 +11,7 @@ import numpy as np
 
 from yade_mpm import analysis
 from yade_mpm._core import MpmSimulationError
-from yade_mpm.fields import FIELDS as _FIELDS, get as _get, fields as _fields
+from yade_mpm.fields import get as _get, fields as _fields
 from .uniaxial import uniaxial_flaw_geometry
 
 SUMMARY_KEYS = ("variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "youngs_modulus_GPa", "wall_time_s",
@@ -125,8 +125,9 @@ def end_analytics(solver, lattice, flaw, snaps, spacing):
             for k, v in snaps.items()} if fl else {}
     # every field but the material velocity, which needs a WLS fit at the current positions: a run the solver stopped
     # on a singular fit (a fragment against a body) must still report its cracks
-    names = [n for n in _FIELDS if n != "vel" and (n != "cohesion" or 1 in solver._materialKinds)]
-    rep = analysis.crack_report(_fields(solver, names), lattice, fl and fl["polygon"], soft, flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * spacing)
+    # every field but the material velocity, which needs a WLS fit at the current positions: a run the solver stopped
+    # on a singular fit (a fragment against a body) must still report its cracks
+    rep = analysis.crack_report(_fields(solver, exclude=("vel",)), lattice, fl and fl["polygon"], soft, flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * spacing)
     pick = lambda cs: [{k: c[k] for k in ("length", "angle_deg", "centroid")} for c in cs[:4]]
     return dict(damaged_fraction_end=float(np.mean(_get(solver, "damage") > 0.99)),
                 cracks_end=pick(rep["cracks"]), shear_bands_end=pick(rep["bands"]),

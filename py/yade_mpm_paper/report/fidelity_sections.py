@@ -75,8 +75,8 @@ def ensemble_rows(R, rows, parts):
         per = []
         for _, f in ms:
             p = dict(parts)
-            for part in scene_parts:
-                p[part] = load_tunnel(R, part, f) if scene == "tunnel" else json.load(open(os.path.join(f, "summary.json")))
+            run = load_tunnel(R, scene_parts[0], f) if scene == "tunnel" else json.load(open(os.path.join(f, "summary.json")))
+            p.update(dict.fromkeys(scene_parts, run))
             per.append(fidelity_table.rows(p))
         for i, r in enumerate(rows):
             if r["part"] in scene_parts:

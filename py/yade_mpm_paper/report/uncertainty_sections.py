@@ -107,9 +107,10 @@ def _penny_quantities(summary):
     """name → value of one line-crack run (scripts/paper/penny_crack.py's summary): Sneddon errors and the crack growth."""
     q = {"u_y L2 rel. error (Sneddon)": summary.get("uy_l2_rel_error"), "u_y rel. error at the centre": summary.get("uy_center_rel_error"),
          "σyy ahead of the tip, L2 rel. error": summary.get("syy_ahead_l2_rel_error")}
+    from ..validation.line_crack import PAPER_DA
     c = summary.get("paper_comparison") or {}
-    for t, da in zip((0.1, 0.2, 0.4), c.get("da_paper_cells") or ()):
-        q[f"Δa at t = {t:g} s [cells] (paper {dict(((0.1, 7), (0.2, 22), (0.4, 72)))[t]})"] = da
+    for (t, paper), da in zip(PAPER_DA, c.get("da_paper_cells") or ()):
+        q[f"Δa at t = {t:g} s [cells] (paper {paper})"] = da
     if c:
         q["first growth, t on the paper's axis [s]"] = c.get("initiation_t_paper_s")
     return q
