@@ -101,7 +101,7 @@ public:
 			if constexpr (checkViews) sched.reach(blk, cellLo, cellHi);
 			const int t         = omp_get_thread_num(); // this block's cut-stencil fits go to thread t's store
 			auto&     cutStore  = cuts.store[size_t(t)];
-			uint32_t& cutUsed   = cuts.used[size_t(t)];
+			uint32_t  cutUsed   = cuts.used[size_t(t)], cutMet = 0; // counted here, stored after the block (no shared line per particle)
 			bool      cutCached = true;
 			cuts.owner[blk] = uint32_t(t), cuts.start[blk] = cutUsed;
 			// The interior path runs inline in the particle loop; cut stencils (p2gCut) and messages are out of line.
@@ -135,7 +135,7 @@ public:
 					fe[a] = m * gravity[a] + (P.hasTraction() ? s * P.trac[a][p] : 0.0); // Eq. 22
 				}
 				if (k.general) {
-					++cuts.need[size_t(t)];
+					++cutMet;
 					cutCached = cutCached && cutUsed < cutStore.size();
 					p2gCut<fused>(p, k, cutCached ? &cutStore[cutUsed++] : nullptr, m, V, sg, mv, mC, fe, dt, err);
 					continue;
@@ -168,6 +168,7 @@ public:
 				}
 			}
 			if (!cutCached) cuts.start[blk] = CutStencilCache<D>::none; // some fit did not fit: the later passes fit again
+			cuts.used[size_t(t)] = cutUsed, cuts.need[size_t(t)] += cutMet;
 		});
 	}
 
