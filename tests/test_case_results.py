@@ -49,7 +49,7 @@ def test_run_names():
 
 
 def test_compression_run_keeps_the_curve_when_the_solver_stops_the_run(tmp_path):
-    # A long run that the solver stops (a particle off the grid, a singular fit) must keep what it measured:
+    # A long run that the solver stops (a particle off the grid, a particle without a fit) must keep what it measured:
     # curve.csv up to the error, result.reason "error" and the message. Here a particle is moved off the grid
     # through a view at step 30, which the solver refuses at the next step.
     import yade_mpm as ym
@@ -87,10 +87,10 @@ def test_compression_run_ends_cleanly_on_sigterm(tmp_path):
     assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL       # the handler is gone after the run
 
 
-def test_end_analytics_of_a_run_stopped_on_a_singular_fit():
-    # A run the solver stopped on a singular WLS fit (a fragment with its stencil nodes excluded, next to a body) still
-    # reports its cracks: the end analytics read no field that needs a fit at the current positions (the material
-    # velocity does, and raises). Here every node is excluded, so every particle's fit is singular.
+def test_end_analytics_of_a_run_stopped_without_a_fit():
+    # A run the solver stopped because a particle has no WLS fit (every stencil node excluded) still reports its
+    # cracks: the end analytics read no field that needs a fit at the current positions (the material velocity
+    # does, and raises). Here every node is excluded, so no particle has a fit.
     import yade_mpm as ym
     from yade_mpm import analysis
     from yade_mpm_paper import cases
@@ -101,7 +101,7 @@ def test_end_analytics_of_a_run_stopped_on_a_singular_fit():
             s._setNodeExcluded(i, True)
         except ValueError:                                  # a ghost node: excluded already
             pass
-    with pytest.raises(ym.MpmSimulationError, match="singular"):
+    with pytest.raises(ym.MpmSimulationError, match="no active grid node"):
         ym.get(s, "vel")
     lattice = analysis.Lattice(ym.get(s, "pos"), s.spacing / 2, origin=(0, 0))
     end = uniaxial_results.end_analytics(s, lattice, None, {}, s.spacing)

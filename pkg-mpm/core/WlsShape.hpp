@@ -7,6 +7,7 @@
 // exact for linear fields. Images of symmetry planes are active nodes (closed form).
 #pragma once
 #include "Grid.hpp"
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 namespace mpm {
@@ -102,8 +103,53 @@ inline void computeKernel(const KernelGeom<D>& g, const Real* x, Kernel<D>& k)
 	k.general = g.stencilExcl[k.base] != 0; // one load: ghosts near the grid edge, planes, gaps, contact
 }
 
-// Fills st from the kernel data. Returns false when the active nodes cannot support a linear fit
-// (singular moment matrix).
+// The fit of a cut stencil whose active nodes do not span a D-simplex (M of Eq. 10 singular: e.g. one row of nodes
+// left beside a body, a fragment with most of its stencil excluded). The same weighted least squares written about
+// the weights' centroid x̄ = Σ w_i x_i / Σ w_i, with the pseudo-inverse of the centred second moment
+// S = Σ w_i (x_i − x̄)(x_i − x̄)ᵀ / Σ w_i (directions with S's eigenvalue below `degenerateSpread` cell² dropped):
+//   ψ_i = w_i/Σw (1 + (x_i − x̄)ᵀ S⁺ (x_p − x̄)),   ∇ψ_i = w_i/Σw S⁺ (x_i − x̄).
+// It keeps Σ ψ_i = 1 and Σ ∇ψ_i = 0 (a rigid motion gives no strain rate), is exact for fields linear along the
+// directions the nodes span and constant across the others, and equals Eq. 15 where M is regular (not used there:
+// the bits of regular fits stay those of M⁻¹). False only when no stencil node is active (Σ w = 0).
+constexpr Real degenerateSpread = 1e-3; // [cell²] smallest kept eigenvalue of S (a full stencil has 1/3)
+template <int D>
+inline bool degenerateFit(Stencil<D>& st, Real invH)
+{
+	constexpr int N = Dim<D>::nStencil;
+	using MatD      = Eigen::Matrix<Real, D, D>;
+	using VecD      = Eigen::Matrix<Real, D, 1>;
+	Real wsum       = 0;
+	VecD c          = VecD::Zero(); // x̄ − x_p [cells]
+	auto dn         = [&](int n) {
+                VecD v;
+                for (int a = 0; a < D; ++a) v[a] = st.d[a][Stencil<D>::along(n, a)] * invH;
+                return v;
+	};
+	for (int n = 0; n < N; ++n) wsum += st.w[n], c += st.w[n] * dn(n);
+	if (!(wsum > 0)) return false;
+	c /= wsum;
+	MatD S = MatD::Zero();
+	for (int n = 0; n < N; ++n) {
+		const VecD r = dn(n) - c;
+		S += (st.w[n] / wsum) * r * r.transpose();
+	}
+	Eigen::SelfAdjointEigenSolver<MatD> es(S);
+	MatD Sp = MatD::Zero(); // S⁺ over the kept directions
+	for (int k = 0; k < D; ++k)
+		if (es.eigenvalues()[k] > degenerateSpread) Sp += es.eigenvectors().col(k) * es.eigenvectors().col(k).transpose() / es.eigenvalues()[k];
+	const VecD g0 = Sp * (-c); // S⁺ (x_p − x̄)
+	for (int n = 0; n < N; ++n) {
+		const VecD r  = dn(n) - c;
+		const Real wn = st.w[n] / wsum;
+		st.psi[n]     = wn * (1 + r.dot(g0));
+		const VecD gr = wn * (Sp * r) * invH;
+		for (int a = 0; a < D; ++a) st.grad[n][a] = gr[a];
+	}
+	return true;
+}
+
+// Fills st from the kernel data. Returns false only when no stencil node is active; a singular moment matrix
+// takes degenerateFit.
 template <int D>
 inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Kernel<D>& k, Stencil<D>& st)
 {
@@ -152,23 +198,24 @@ inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Ker
 		for (int j = 0; j <= D; ++j) M(i, j) = Ms[i][j];
 	// M is SPD when the active nodes span a D-simplex; its smallest scale is ~1e-2 in cell units.
 	Real det = M.determinant();
-	if (!(std::abs(det) > 1e-12)) {
+	if (std::abs(det) > 1e-12) {
+		const MatP Minv = M.inverse();
+		for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient: q = M⁻¹ p_n
+			Real pn[D + 1], q[D + 1];
+			basis(n, pn);
+			for (int i = 0; i <= D; ++i) {
+				q[i] = Minv(i, 0) * pn[0];
+				for (int j = 1; j <= D; ++j) q[i] += Minv(i, j) * pn[j];
+			}
+			st.psi[n] = st.w[n] * q[0];
+			for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
+		}
+	} else if (!degenerateFit(st, invH)) { // no active node at all
 		for (int n = 0; n < N; ++n) {
 			st.psi[n] = 0;
 			for (int a = 0; a < D; ++a) st.grad[n][a] = 0;
 		}
 		return false;
-	}
-	const MatP Minv = M.inverse();
-	for (int n = 0; n < N; ++n) { // Eq. 15 at x = x_p and its gradient: q = M⁻¹ p_n
-		Real pn[D + 1], q[D + 1];
-		basis(n, pn);
-		for (int i = 0; i <= D; ++i) {
-			q[i] = Minv(i, 0) * pn[0];
-			for (int j = 1; j <= D; ++j) q[i] += Minv(i, j) * pn[j];
-		}
-		st.psi[n] = st.w[n] * q[0];
-		for (int a = 0; a < D; ++a) st.grad[n][a] = st.w[n] * q[a + 1] * invH;
 	}
 	// Lumping weights of a cut stencil (mass, momentum, external force; Eq. 20 with positive weights):
 	// η_i = ½ (w_i/Σ_active w + ψ⁺_i/Σ_j ψ⁺_j) ≥ 0, ψ⁺ = max(ψ, 0), Σ η = 1; ψ_i, ∇ψ_i keep the fit (Eqs. 15, 21, 7).

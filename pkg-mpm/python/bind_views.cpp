@@ -64,7 +64,7 @@ struct ViewsWrap {
 		auto*       o   = reinterpret_cast<double*>(out.get_data());
 		for (size_t p = 0; p < s.P.n; ++p) {
 			Real v[D];
-			if (!s.materialVelocity(p, v)) throw SimulationError("materialVelocity: particle " + std::to_string(s.P.id[p]) + " has a singular WLS fit");
+			if (!s.materialVelocity(p, v)) throw SimulationError("materialVelocity: particle " + std::to_string(s.P.id[p]) + " has no active grid node in its WLS stencil (every node excluded)");
 			for (int a = 0; a < D; ++a) o[p * D + a] = v[a];
 		}
 		return out;
@@ -87,7 +87,7 @@ struct ViewsWrap {
 			xa[a] = x[a];
 			if (!(x[a] >= s.grid.origin[a] && x[a] < s.grid.upper()[a])) throw InputError("point is outside the grid");
 		}
-		if (!computeStencil(s.grid, so, xa, st)) throw SimulationError("singular WLS moment matrix at this point");
+		if (!computeStencil(s.grid, so, xa, st)) throw SimulationError("no active grid node in the WLS stencil of this point (every node excluded)");
 		constexpr int N   = Dim<D>::nStencil;
 		np::ndarray   idx = np::empty(bp::make_tuple(N), np::dtype::get_builtin<int64_t>());
 		np::ndarray   psi = np::empty(bp::make_tuple(N), np::dtype::get_builtin<double>());

@@ -220,7 +220,7 @@ public:
 		});
 	}
 
-	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (vmusl, Eq. 7). False if the WLS fit is singular.
+	// ∇v_p = Σ v_i ⊗ ∇ψ_i over the MUSL nodal velocities (vmusl, Eq. 7). False if no stencil node is active.
 	// general: a cut stencil, whose v_p stands at x̄_p = x_p + dbar (g2p); dbar is left untouched otherwise.
 	// g: KernelGeom of the grid, made once per pass; cut: the block's next cached fit (cuts.block), advanced when used.
 	bool velocityGradient(const KernelGeom<D>& g, size_t p, Real (&L)[D][D], bool& general, Real (&dbar)[D], const Stencil<D>*& cut) const
@@ -240,7 +240,7 @@ public:
 
 	// Velocity of the material point x_p: v_p + C_p (x_p − x̄_p). A cut stencil's v_p is the velocity at x̄_p (g2p:
 	// Σ_p m_p v_p is the grid's momentum), so the material point moves with this one (updateStress); x̄_p from the
-	// current positions and node exclusions (those of the last step until the next one starts). False: singular fit.
+	// current positions and node exclusions (those of the last step until the next one starts). False: no stencil node active.
 	bool materialVelocity(size_t p, Real (&v)[D]) const
 	{
 		Kernel<D> k;
@@ -280,7 +280,7 @@ private:
 	{
 		Stencil<D>  local;
 		Stencil<D>& st = slot ? *slot : local;
-		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has no active grid node in its WLS stencil (every node excluded)");
 		forStencil(grid.nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
 			const Real eta = st.eta[n];
 			nd.m += eta * m;       // Eq. 20, positive lumping
@@ -301,12 +301,12 @@ private:
 	// G2P of a particle with a cut stencil: v_p = Σ η_i v_i, the velocity at x̄_p (Σ_p m_p v_p = Σ_i m_i v_i: momentum
 	// conserved; exact for linear nodal fields at x̄_p), ∇v_p from the fit (Eq. 7). The position update adds
 	// ∇v_p (x_p − x̄_p) (updateStress), so the particle moves with the velocity at x_p.
-	// cached: P2G's fit of this particle (nullptr: fit again; P2G accepted it, so it is not singular).
+	// cached: P2G's fit of this particle (nullptr: fit again; P2G accepted it, so some node is active).
 	template <bool flip>
 	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, const Stencil<D>* cached, ErrorRecord& err)
 	{
 		Stencil<D> local;
-		if (!cached && !fillStencil(grid, offs, k, local)) return err.record(p, "has too few active grid nodes for the WLS fit (singular moment matrix)");
+		if (!cached && !fillStencil(grid, offs, k, local)) return err.record(p, "has no active grid node in its WLS stencil (every node excluded)");
 		const Stencil<D>& st = cached ? *cached : local;
 		const Real m = P.mass[p];
 		Real       v[D] = {}, C[D][D] = {};

@@ -124,9 +124,7 @@ def end_analytics(solver, lattice, flaw, snaps, spacing):
     near = {k: near_segment_stress(lattice.x0, v[:, 4], fl["toe"], fl["tip"], fl["width"] / 2 + spacing)
             for k, v in snaps.items()} if fl else {}
     # every field but the material velocity, which needs a WLS fit at the current positions: a run the solver stopped
-    # on a singular fit (a fragment against a body) must still report its cracks
-    # every field but the material velocity, which needs a WLS fit at the current positions: a run the solver stopped
-    # on a singular fit (a fragment against a body) must still report its cracks
+    # (a particle with no active stencil node, e.g. inside a body) must still report its cracks
     rep = analysis.crack_report(_fields(solver, exclude=("vel",)), lattice, fl and fl["polygon"], soft, flaw=fl and (fl["toe"], fl["tip"]), band_gap=2 * spacing)
     pick = lambda cs: [{k: c[k] for k in ("length", "angle_deg", "centroid")} for c in cs[:4]]
     return dict(damaged_fraction_end=float(np.mean(_get(solver, "damage") > 0.99)),
