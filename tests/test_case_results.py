@@ -1,5 +1,7 @@
 """The run records of yade_mpm_paper.cases.tunnel_results / uniaxial_results on constructed curves whose
 answers are known (the scripts' end-to-end tests run them on real runs: test_tunnel_script, test_studies)."""
+import json
+
 import numpy as np
 import pytest
 
@@ -31,6 +33,30 @@ def test_peak_and_modulus_of_a_linear_then_softening_curve():
     k, e_fit = uniaxial_results.peak_and_modulus(eps, sig)
     assert eps[k] == pytest.approx(1e-3) and e_fit == pytest.approx(E, rel=1e-9)
     assert np.isnan(uniaxial_results.peak_and_modulus(eps[:3], sig[:3])[1])     # too few points before the peak
+
+
+def test_a_reaction_spike_is_not_the_peak(tmp_path):
+    # A one-step spike of the platen reaction (a diverging fragment under the platen's edge) after a smooth peak: the
+    # peak and the modulus are those of the smooth curve, and the spikes are counted; a record written before spikes
+    # were told apart is derived again from its curve.csv.
+    eps = np.linspace(0, 2e-3, 201)
+    E = 7.3e9
+    sig = np.where(eps <= 1e-3, E * eps, E * 1e-3 - 2e9 * (eps - 1e-3))
+    clean = uniaxial_results.peak_and_modulus(eps, sig)
+    spiky = sig.copy()
+    spiky[150] *= 4.0                                                            # 4 × the value, one sample
+    spiky[60] += 0.45 * sig[59]                                                  # below the share: not a spike
+    assert list(uniaxial_results.reaction_spikes(spiky)) == [150]
+    assert uniaxial_results.peak_and_modulus(eps, spiky) == clean
+    assert len(uniaxial_results.reaction_spikes(sig)) == 0
+    t = np.arange(len(eps)) * 1e-7
+    np.savetxt(tmp_path / "curve.csv", np.column_stack([t, eps, spiky / 1e6]), delimiter=",", header="time_s,axial_strain,axial_stress_MPa")
+    entry = dict(dir=str(tmp_path), peak_stress_MPa=float(spiky.max() / 1e6), strain_at_peak=0.0)
+    assert uniaxial_results.rescore(entry)
+    assert entry["peak_stress_MPa"] == pytest.approx(sig.max() / 1e6) and entry["strain_at_peak"] == pytest.approx(1e-3)
+    assert entry["reaction_spikes"] == dict(count=1, first_time_s=pytest.approx(t[150]), largest_MPa=pytest.approx(spiky[150] / 1e6))
+    assert json.load(open(tmp_path / "run.json"))["peak_stress_MPa"] == entry["peak_stress_MPa"]
+    assert not uniaxial_results.rescore(entry)                                   # done once
 
 
 def test_softened_only_past_a_real_peak():

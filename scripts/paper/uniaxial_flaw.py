@@ -127,7 +127,7 @@ def one_run(variant, mu, c_mpa, a):
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
                  plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"],
                  removed_particles=int(ym.removed(s)["count"]), removed_mass_kg=float(ym.removed(s)["mass"]),   # debris off the grid
-                 end_analytics_error=end.get("error"))
+                 end_analytics_error=end.get("error"), reaction_spikes=results.spike_record(t, sig))
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "
@@ -213,6 +213,9 @@ def summarize(out):
     if not runs:
         print(f"no runs under {out}/runs")
         return None
+    for e in runs:                                 # records from before reaction spikes were told apart
+        if results.rescore(e):
+            print(f"{e['dir']}: peak and modulus derived again from curve.csv (reaction spikes: {e['reaction_spikes']})")
     sweep_png(runs, out, "mu", MU_SWEEP, "curves_mu.png", "filled flaw, c_con = 0 (Fig. 13a-like)")
     sweep_png(runs, out, "c", C_SWEEP_MPA, "curves_c.png", "filled flaw, μ_con = 0 (Fig. 13b-like)")
     for e in runs:

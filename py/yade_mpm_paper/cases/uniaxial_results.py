@@ -18,7 +18,7 @@ SUMMARY_KEYS = ("variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_
                 "particles", "steps", "particle_steps_per_s")            # peaks.csv / peaks.md columns
 RUN_KEYS = SUMMARY_KEYS + ("time_at_peak_s", "end_reason", "filler_motion", "damaged_fraction_end", "crack_times", "near_flaw_sigma_max",
                            "plastic_before_peak", "cracks_end", "flaw_end_cracks_end", "shear_bands_end",
-                           "time_reached_s", "error")   # summary.json runs
+                           "time_reached_s", "error", "reaction_spikes")   # summary.json runs
 ROW_KEYS = ("variant", "mu_con", "c_con_MPa", "spacing_m", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s",
             "youngs_modulus_GPa", "particles", "steps", "end_reason", "softened", "damaged_fraction_end")   # a study's row
 
@@ -91,12 +91,59 @@ def compression_run(solver, scene, folder, end_time, progress, label, snapshot, 
     return dict(result=res, wall_s=wall, t=t, eps=eps, sig=sig, peak=k, E=E)
 
 
+SPIKE_SHARE = 0.5   # a reaction sample above both neighbours by more than this share of the curve's maximum so far
+
+
+def reaction_spikes(sig):
+    """Indices of one-sample spikes of a platen reaction recorded every step: a sample above both its neighbours by
+    more than SPIKE_SHARE of the largest value before it. A specimen's reaction cannot jump and fall back within two
+    steps (0.2 µs at the paper's grid); a lone fragment whose velocity diverges under the platen's edge makes it do
+    so (doc/validation/uniaxial_flaw.md, "Reaction spikes")."""
+    s = np.asarray(sig, float)
+    if len(s) < 3:
+        return np.zeros(0, int)
+    before = np.maximum.accumulate(s)[:-2]          # the largest value before sample j (j = 1 … n − 2)
+    excess = s[1:-1] - np.maximum(s[:-2], s[2:])
+    return np.flatnonzero((before > 0) & (excess > SPIKE_SHARE * before)) + 1
+
+
 def peak_and_modulus(eps, sig):
     """Index of the peak stress and Young's modulus [Pa]: the slope fitted between 10 and 40 % of the
-    peak before it (NaN with fewer than 4 such points)."""
-    k = int(np.argmax(sig))
+    peak before it (NaN with fewer than 4 such points). The peak is sought before the first reaction spike
+    (reaction_spikes), which is not a response of the specimen."""
+    spikes = reaction_spikes(sig)
+    k = int(np.argmax(sig[:spikes[0]] if len(spikes) else sig))
     pre = (sig > 0.1 * sig[k]) & (sig < 0.4 * sig[k]) & (np.arange(len(sig)) < k)
     return k, (np.polyfit(eps[pre], sig[pre], 1)[0] if pre.sum() > 3 else float("nan"))
+
+
+def spike_record(t, sig):
+    """What a run's record says of its reaction spikes (reaction_spikes): None, or their count, the time of the
+    first and the largest spike [MPa]."""
+    sp = reaction_spikes(sig)
+    if not len(sp):
+        return None
+    return dict(count=int(len(sp)), first_time_s=float(t[sp[0]]), largest_MPa=float(np.max(np.asarray(sig)[sp]) / 1e6))
+
+
+def rescore(entry):
+    """A run record written before reaction spikes were told apart (no "reaction_spikes" key): its peak, modulus,
+    plastic share before the peak and spikes derived again from its curve.csv and snapshots.npz, and written back to
+    its run.json. Returns True when the record changed."""
+    if "reaction_spikes" in entry or not os.path.exists(os.path.join(entry["dir"], "curve.csv")):
+        return False
+    t, eps, sig = np.loadtxt(os.path.join(entry["dir"], "curve.csv"), delimiter=",", skiprows=1, ndmin=2).T
+    sig = sig * 1e6
+    k, E = peak_and_modulus(eps, sig)
+    entry.update(peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]),
+                 youngs_modulus_GPa=float(E / 1e9), reaction_spikes=spike_record(t, sig))
+    snaps = os.path.join(entry["dir"], "snapshots.npz")
+    if "plastic_before_peak" in entry and os.path.exists(snaps):
+        with np.load(snaps) as z:
+            entry["plastic_before_peak"] = plastic_before({q: z[q] for q in z.files}, t[k])
+    with open(os.path.join(entry["dir"], "run.json"), "w") as f:
+        json.dump({q: v for q, v in entry.items() if q != "dir"}, f, indent=1)
+    return True
 
 
 def filler_motion(body):

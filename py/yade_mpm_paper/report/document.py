@@ -17,7 +17,7 @@ PARTS = {
     "stability": "/usr/bin/python3 scripts/paper/stability.py --out out/stability",
     "uniaxial_flaw": "/usr/bin/python3 scripts/paper/uniaxial_flaw.py --out out/uniaxial_flaw",
     "tunnel": "./run.sh   (= /usr/bin/python3 scripts/paper/tunnel_spalling.py --out out/tunnel)",
-    "uniaxial_paper": "/usr/bin/python3 scripts/paper/uniaxial_flaw.py --out out/uniaxial_paper --paper --runs open,filled:0:0,filled:0.6:0,filled:0:5,filled:0:10",
+    "uniaxial_paper": "/usr/bin/python3 scripts/paper/uniaxial_flaw.py --out out/uniaxial_paper --paper",
     "tunnel_paper": "/usr/bin/python3 scripts/paper/tunnel_spalling.py --out out/tunnel_paper --paper --threads 2 --cases intact,open_flaw,filled_flaw",
 }
 

@@ -67,7 +67,15 @@ def stability(R):
 
 
 RUN_COLUMNS = ("variant", "mu_con", "c_con_MPa", "peak_stress_MPa", "strain_at_peak", "time_at_peak_s", "end_reason",
-               "time_reached_s", "wall_time_s", "particles")   # a uniaxial run's row: how and when it ended beside its peak
+               "time_reached_s", "reaction_spikes", "wall_time_s", "particles")   # a uniaxial run's row: how and when it ended beside its peak
+
+
+def run_cell(r, c):
+    """A uniaxial run's table cell: its reaction spikes (uniaxial_results.spike_record) in words, else the value."""
+    v = r.get(c)
+    if c == "reaction_spikes" and isinstance(v, dict):
+        return f"{v['count']} from {v['first_time_s'] * 1e3:.3f} ms (largest {v['largest_MPa']:.0f} MPa)"
+    return v
 
 
 def uniaxial(R, part="uniaxial_flaw", title="Uniaxial compression with a flaw (paper Sec. 3.3)"):
@@ -84,7 +92,7 @@ def uniaxial(R, part="uniaxial_flaw", title="Uniaxial compression with a flaw (p
             keys = [c for c in v[0] if isinstance(v[0][c], (int, float, str, bool)) or v[0][c] is None]
             keys = [c for c in RUN_COLUMNS if c in keys] or keys[:8]
             R.w(f"**{k}**", "")
-            R.w(*table(v, [(c, (lambda c: lambda r: r.get(c))(c)) for c in keys]))
+            R.w(*table(v, [(c, (lambda c: lambda r: run_cell(r, c))(c)) for c in keys]))
     R.figures(part, ["curves_mu.png", "curves_c.png", "damage_plastic_open.png", "damage_plastic_filled_mu0.6_c0MPa.png"])
 
 
