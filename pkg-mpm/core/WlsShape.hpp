@@ -148,8 +148,11 @@ inline bool degenerateFit(Stencil<D>& st, Real invH)
 	return true;
 }
 
-// Fills st from the kernel data. Returns false only when no stencil node is active; a singular moment matrix
-// takes degenerateFit.
+// What a pass reports of a particle whose fit fillStencil refused (after "particle id N ").
+constexpr const char* noActiveNodeMessage = "has no active grid node in its WLS stencil (every node excluded)";
+
+// Fills st from the kernel data. Returns false only when no stencil node is active (noActiveNodeMessage); a singular
+// moment matrix takes degenerateFit.
 template <int D>
 inline bool fillStencil(const Grid<D>& g, const StencilOffsets<D>& so, const Kernel<D>& k, Stencil<D>& st)
 {

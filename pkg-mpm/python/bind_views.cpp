@@ -64,7 +64,7 @@ struct ViewsWrap {
 		auto*       o   = reinterpret_cast<double*>(out.get_data());
 		for (size_t p = 0; p < s.P.n; ++p) {
 			Real v[D];
-			if (!s.materialVelocity(p, v)) throw SimulationError("materialVelocity: particle " + std::to_string(s.P.id[p]) + " has no active grid node in its WLS stencil (every node excluded)");
+			if (!s.materialVelocity(p, v)) throw SimulationError("materialVelocity: particle " + std::to_string(s.P.id[p]) + " " + noActiveNodeMessage);
 			for (int a = 0; a < D; ++a) o[p * D + a] = v[a];
 		}
 		return out;

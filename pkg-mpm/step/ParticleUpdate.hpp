@@ -34,7 +34,7 @@ inline ParticleStepStats updateStress(const Transfer<D>& tr, const Mat& mat, Rea
 			Real L[D][D] = {}, dbar[D];
 			bool cut;
 			if (!tr.velocityGradient(geo, p, L, cut, dbar, fits)) {
-				err.record(p, "has no active grid node in its WLS stencil (every node excluded)");
+				err.record(p, noActiveNodeMessage);
 				continue;
 			}
 			if (cut) // v_p stands at x̄_p (Transfer::g2p): move with v_p + ∇v_p (x_p − x̄_p), the velocity at x_p

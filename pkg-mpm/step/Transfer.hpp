@@ -280,7 +280,7 @@ private:
 	{
 		Stencil<D>  local;
 		Stencil<D>& st = slot ? *slot : local;
-		if (!fillStencil(grid, offs, k, st)) return err.record(p, "has no active grid node in its WLS stencil (every node excluded)");
+		if (!fillStencil(grid, offs, k, st)) return err.record(p, noActiveNodeMessage);
 		forStencil(grid.nodes.data(), offs, st, [&](Node<D>& nd, int n, const Real(&dx)[D]) {
 			const Real eta = st.eta[n];
 			nd.m += eta * m;       // Eq. 20, positive lumping
@@ -306,7 +306,7 @@ private:
 	[[gnu::noinline]] void g2pCut(size_t p, const Kernel<D>& k, const Stencil<D>* cached, ErrorRecord& err)
 	{
 		Stencil<D> local;
-		if (!cached && !fillStencil(grid, offs, k, local)) return err.record(p, "has no active grid node in its WLS stencil (every node excluded)");
+		if (!cached && !fillStencil(grid, offs, k, local)) return err.record(p, noActiveNodeMessage);
 		const Stencil<D>& st = cached ? *cached : local;
 		const Real m = P.mass[p];
 		Real       v[D] = {}, C[D][D] = {};
