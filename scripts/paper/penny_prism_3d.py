@@ -63,8 +63,7 @@ def one_run(a, variant, symmetry):
     wall, t, eps, sig, k, E = r["wall_s"], r["t"], r["eps"], r["sig"], r["peak"], r["E"]
     np.savez_compressed(os.path.join(d, "snapshots.npz"), **snaps)
     entry = dict(variant=variant, symmetry=symmetry, spacing_m=a.spacing, particles=int(s.numParticles), steps=int(s.steps),
-                 wall_time_s=wall, end_reason=r["result"].reason, peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]),
-                 time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9), onset={str(k_): v for k_, v in onset.items()},
+                 wall_time_s=wall, end_reason=r["result"].reason, **results.peak_fields(t, eps, sig, k, E), onset={str(k_): v for k_, v in onset.items()},
                  damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))
     if fl:
         fl_json = dict(radius_m=fl["radius"], thickness_m=fl["thickness"], angle_deg=float(np.degrees(fl["angle"])),

@@ -116,8 +116,7 @@ def one_run(variant, mu, c_mpa, a):
         print(f"[{name}] end analytics failed: {e}", flush=True)
         end = dict.fromkeys(("damaged_fraction_end", "cracks_end", "shear_bands_end", "near_flaw_sigma_max", "flaw_end_cracks_end"))
         end["error"] = str(e)
-    entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, peak_stress_MPa=float(sig[k] / 1e6),
-                 strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
+    entry = dict(variant=variant, mu_con=mu, c_con_MPa=c_mpa, **results.peak_fields(t, eps, sig, k, E),
                  wall_time_s=wall, particles=int(s.numParticles), steps=int(s.steps),
                  particle_steps_per_s=s.numParticles * s.steps / wall, end_reason=r["result"].reason,
                  error=getattr(r["result"], "error", None), time_reached_s=float(t[-1]),
@@ -127,7 +126,7 @@ def one_run(variant, mu, c_mpa, a):
                  crack_times=times.result() if times else None, near_flaw_sigma_max=end["near_flaw_sigma_max"],
                  plastic_before_peak=results.plastic_before(snaps, t[k]), flaw_end_cracks_end=end["flaw_end_cracks_end"],
                  removed_particles=int(ym.removed(s)["count"]), removed_mass_kg=float(ym.removed(s)["mass"]),   # debris off the grid
-                 end_analytics_error=end.get("error"), reaction_spikes=results.spike_record(t, sig))
+                 end_analytics_error=end.get("error"))
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)
     print(f"[{name}] peak {entry['peak_stress_MPa']:.2f} MPa at ε = {entry['strain_at_peak']:.4g}, E = {entry['youngs_modulus_GPa']:.2f} GPa, "

@@ -63,8 +63,7 @@ def one_run(a, slab_cells):
     entry = dict(dim=3 if slab_cells else 2, slab_cells=slab_cells, variant=a.variant, threshold_volume=str(rock.thresholdVolume),
                  eps0_median=float(np.median(s.view("eps0"))), spacing_m=a.spacing, courant=a.courant,
                  particles=int(s.numParticles), steps=int(s.steps), wall_time_s=wall, end_reason=r["result"].reason,
-                 particle_steps_per_s=s.numParticles * s.steps / wall, peak_stress_MPa=float(sig[k] / 1e6),
-                 strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]), youngs_modulus_GPa=float(E / 1e9),
+                 particle_steps_per_s=s.numParticles * s.steps / wall, **results.peak_fields(t, eps, sig, k, E),
                  thickness_m=sc["thickness"], damaged_fraction_end=float(np.mean(ym.get(s, "damage") > 0.99)))
     with open(os.path.join(d, "run.json"), "w") as f:
         json.dump(entry, f, indent=1)

@@ -126,17 +126,23 @@ def spike_record(t, sig):
     return dict(count=int(len(sp)), first_time_s=float(t[sp[0]]), largest_MPa=float(np.max(np.asarray(sig)[sp]) / 1e6))
 
 
+def peak_fields(t, eps, sig, k, E):
+    """A run record's fields of its curve (t [s], ε, σ [Pa]) with the peak at index k and Young's modulus E [Pa]
+    (peak_and_modulus), and its reaction spikes (spike_record)."""
+    return dict(peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]),
+                youngs_modulus_GPa=float(E / 1e9), reaction_spikes=spike_record(t, sig))
+
+
 def rescore(entry):
     """A run record written before reaction spikes were told apart (no "reaction_spikes" key): its peak, modulus,
     plastic share before the peak and spikes derived again from its curve.csv and snapshots.npz, and written back to
     its run.json. Returns True when the record changed."""
     if "reaction_spikes" in entry or not os.path.exists(os.path.join(entry["dir"], "curve.csv")):
         return False
-    t, eps, sig = np.loadtxt(os.path.join(entry["dir"], "curve.csv"), delimiter=",", skiprows=1, ndmin=2).T
+    t, eps, sig = read_curve(entry, with_time=True)
     sig = sig * 1e6
     k, E = peak_and_modulus(eps, sig)
-    entry.update(peak_stress_MPa=float(sig[k] / 1e6), strain_at_peak=float(eps[k]), time_at_peak_s=float(t[k]),
-                 youngs_modulus_GPa=float(E / 1e9), reaction_spikes=spike_record(t, sig))
+    entry.update(peak_fields(t, eps, sig, k, E))
     snaps = os.path.join(entry["dir"], "snapshots.npz")
     if "plastic_before_peak" in entry and os.path.exists(snaps):
         with np.load(snaps) as z:
@@ -200,10 +206,10 @@ def find_run(runs, variant, mu=0.0, c=0.0):
     return None
 
 
-def read_curve(e):
-    """(axial strain, axial stress [MPa]) of a run's curve.csv."""
+def read_curve(e, with_time=False):
+    """(axial strain, axial stress [MPa]) of a run's curve.csv; with_time: (time [s], strain, stress [MPa])."""
     c = np.loadtxt(os.path.join(e["dir"], "curve.csv"), delimiter=",", skiprows=1, ndmin=2)
-    return c[:, 1], c[:, 2]
+    return (c[:, 0], c[:, 1], c[:, 2]) if with_time else (c[:, 1], c[:, 2])
 
 
 def read_snapshot(e, t):
